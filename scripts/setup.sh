@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs the Debian packages zebrageo needs, when they are missing.
+# Safe to run repeatedly: it only calls apt-get when something is absent.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
+  libopencv-dev libgeographiclib-dev
+  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libbz2-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libboost-dev
+  python3 python3-numpy python3-opencv python3-yaml
+)
+
+missing=()
+for package in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}" >&2
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "setup: need root (or sudo) to install: ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "setup: done" >&2

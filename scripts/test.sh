@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Builds and runs every test: a Release build with warnings as errors, then
+# the unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+jobs="$(nproc)"
+
+"$here/scripts/build.sh" "$here/build" -DZEBRAGEO_WERROR=ON
+ctest --test-dir "$here/build" --output-on-failure -j "$jobs"
+
+# Sanitizer build: tests only (no benchmarks), Debug-like optimisation so
+# the reports point at lines, still fast enough for CI's 2 cores.
+"$here/scripts/build.sh" "$here/build-asan" -DZEBRAGEO_WERROR=ON \
+  -DZEBRAGEO_SANITIZE=ON -DZEBRAGEO_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --test-dir "$here/build-asan" --output-on-failure -j "$jobs" -L sanitize

@@ -1,0 +1,283 @@
+#include "survey/survey.h"
+
+#include <glog/logging.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "survey/atomic_file.h"
+#include "survey/csv.h"
+#include "survey/input_error.h"
+
+namespace zebrageo {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kManifestFile[] = "survey.yaml";
+
+int LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.is_null() ? 0 : mark.line + 1;
+}
+
+[[noreturn]] void Fail(const YAML::Node& node, const std::string& problem) {
+  throw InputError(kManifestFile, LineOf(node), problem);
+}
+
+// A file key: required, a non-empty string naming an existing file.
+std::string FileKey(const YAML::Node& root, const char* key,
+                    const std::string& survey_folder) {
+  const YAML::Node node = root[key];
+  if (!node || node.IsNull()) {
+    Fail(root, std::string("missing key '") + key + "'");
+  }
+  if (!node.IsScalar() || node.Scalar().empty()) {
+    Fail(node, std::string("'") + key + "' must be a file name");
+  }
+  const std::string name = node.Scalar();
+  std::error_code error;
+  if (!fs::is_regular_file(fs::path(survey_folder) / name, error)) {
+    Fail(node,
+         std::string("'") + key + "' names " + name + ", which does not exist");
+  }
+  return name;
+}
+
+Geodetic ParseOrigin(const YAML::Node& node) {
+  if (!node.IsSequence() || node.size() != 3) {
+    Fail(node, "'origin' must be [lat, lon, h] (degrees, degrees, metres)");
+  }
+  double values[3];
+  for (int i = 0; i < 3; ++i) {
+    if (!node[i].IsScalar() ||
+        !YAML::convert<double>::decode(node[i], values[i]) ||
+        !std::isfinite(values[i])) {
+      Fail(node[i], "'origin' must be 3 finite numbers [lat, lon, h]");
+    }
+  }
+  if (values[0] < -90.0 || values[0] > 90.0) {
+    Fail(node, "'origin' latitude " + FormatDouble(values[0]) +
+                   " is outside [-90, 90] (the order is [lat, lon, h])");
+  }
+  if (values[1] < -180.0 || values[1] > 180.0) {
+    Fail(node, "'origin' longitude " + FormatDouble(values[1]) +
+                   " is outside [-180, 180]");
+  }
+  return Geodetic{values[0], values[1], values[2]};
+}
+
+// A file name as a YAML scalar: plain when it can only be read as a string
+// ("rig.yaml", "data/exposures.csv"), double-quoted otherwise.
+std::string YamlString(const std::string& text) {
+  bool plain =
+      !text.empty() && std::isalpha(static_cast<unsigned char>(text.front()));
+  for (char c : text) {
+    plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+                      c == '-' || c == '.' || c == '/');
+  }
+  std::string lower;
+  for (char c : text) {
+    lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  for (const char* keyword :
+       {"y", "n", "yes", "no", "true", "false", "on", "off", "null"}) {
+    plain = plain && lower != keyword;
+  }
+  if (plain) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
+
+}  // namespace
+
+SurveyManifest ReadManifest(const std::string& survey_folder) {
+  const std::string path = (fs::path(survey_folder) / kManifestFile).string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(
+        kManifestFile, 0,
+        "cannot open " + path + " (is " + survey_folder + " a survey folder?)");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    throw InputError(kManifestFile, e.mark.is_null() ? 0 : e.mark.line + 1,
+                     "malformed YAML: " + e.msg);
+  }
+  if (!root.IsMap()) {
+    Fail(root,
+         "expected a mapping with keys name, rig, trajectory, "
+         "exposures, roadmarks");
+  }
+  SurveyManifest manifest;
+  const YAML::Node name = root["name"];
+  if (name && name.IsScalar()) {
+    manifest.name = name.Scalar();
+  } else if (name && !name.IsNull()) {
+    Fail(name, "'name' must be a string");
+  } else {
+    // The name only labels reports: the folder's name will do.
+    manifest.name =
+        fs::path(survey_folder).lexically_normal().filename().string();
+    if (manifest.name.empty()) {
+      manifest.name = fs::path(survey_folder)
+                          .lexically_normal()
+                          .parent_path()
+                          .filename()
+                          .string();
+    }
+  }
+  manifest.rig = FileKey(root, "rig", survey_folder);
+  manifest.trajectory = FileKey(root, "trajectory", survey_folder);
+  manifest.exposures = FileKey(root, "exposures", survey_folder);
+  manifest.roadmarks = FileKey(root, "roadmarks", survey_folder);
+  const YAML::Node origin = root["origin"];
+  if (origin && !origin.IsNull()) manifest.origin = ParseOrigin(origin);
+  return manifest;
+}
+
+void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
+  AtomicFile file(path);
+  std::ostream& out = file.stream();
+  out << "name: " << YamlString(manifest.name) << "\n"
+      << "rig: " << YamlString(manifest.rig) << "\n"
+      << "trajectory: " << YamlString(manifest.trajectory) << "\n"
+      << "exposures: " << YamlString(manifest.exposures) << "\n"
+      << "roadmarks: " << YamlString(manifest.roadmarks) << "\n";
+  if (manifest.origin.has_value()) {
+    const Geodetic& o = *manifest.origin;
+    if (!std::isfinite(o.lat_deg) || !std::isfinite(o.lon_deg) ||
+        !std::isfinite(o.h_m)) {
+      throw std::invalid_argument("WriteManifest: non-finite origin");
+    }
+    out << "origin: [" << FormatDouble(o.lat_deg) << ", "
+        << FormatDouble(o.lon_deg) << ", " << FormatDouble(o.h_m)
+        << "]  # lat, lon, h of the ENU origin\n";
+  }
+  file.Commit();
+}
+
+std::string SurveyLoadOptions::Check() const {
+  if (!(max_missing_image_fraction >= 0.0 &&
+        max_missing_image_fraction <= 1.0)) {
+    std::ostringstream message;
+    message << "max_missing_image_fraction = " << max_missing_image_fraction
+            << ": must be in [0, 1]";
+    return message.str();
+  }
+  return "";
+}
+
+std::string Survey::PathOf(const std::string& relative) const {
+  return (fs::path(folder) / relative).string();
+}
+
+Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
+  const std::string problem = options.Check();
+  if (!problem.empty()) {
+    throw std::invalid_argument("SurveyLoadOptions: " + problem);
+  }
+  Survey survey;
+  survey.folder = folder;
+  survey.manifest = ReadManifest(folder);
+  const SurveyManifest& manifest = survey.manifest;
+
+  survey.rig = ReadRig(survey.PathOf(manifest.rig), manifest.rig);
+  if (survey.rig.stereo_pairs.empty()) {
+    throw InputError(manifest.rig, 0,
+                     "no stereo_pairs: zebrageo needs at least one stereo "
+                     "pair to reconstruct road marks");
+  }
+  std::vector<TrajectorySample> samples = ReadTrajectorySamples(
+      survey.PathOf(manifest.trajectory), manifest.trajectory);
+  const Geodetic origin = manifest.origin.value_or(samples.front().position);
+  survey.frame = LocalFrame(origin);
+  survey.trajectory = Trajectory(std::move(samples), survey.frame);
+
+  survey.exposures = ReadExposures(survey.PathOf(manifest.exposures),
+                                   manifest.exposures, survey.rig);
+  // Poses are interpolated, never extrapolated: an INS drifts fastest
+  // exactly where it has no solution.
+  for (const ExposureImage& image : survey.exposures.images) {
+    if (!survey.trajectory.Covers(image.time)) {
+      throw InputError(manifest.exposures, image.line,
+                       "exposure " + std::to_string(image.exposure_id) +
+                           " at time " + FormatDouble(image.time) +
+                           " is outside the trajectory's span [" +
+                           FormatDouble(survey.trajectory.start_time()) + ", " +
+                           FormatDouble(survey.trajectory.end_time()) +
+                           "] of " + manifest.trajectory);
+    }
+  }
+
+  // Missing images: a few are warnings (the survey stays usable), many mean
+  // a wrong folder or a broken copy.
+  std::vector<bool> present(survey.exposures.images.size(), true);
+  int missing = 0;
+  std::string first_missing;
+  for (size_t i = 0; i < survey.exposures.images.size(); ++i) {
+    const ExposureImage& image = survey.exposures.images[i];
+    std::error_code error;
+    if (!fs::is_regular_file(survey.PathOf(image.image), error)) {
+      present[i] = false;
+      ++missing;
+      const std::string warning = manifest.exposures + ":" +
+                                  std::to_string(image.line) + ": image " +
+                                  image.image + " does not exist";
+      if (first_missing.empty()) first_missing = warning;
+      LOG(WARNING) << warning;
+      survey.warnings.push_back(warning);
+    }
+  }
+  const int total = static_cast<int>(survey.exposures.images.size());
+  if (missing > options.max_missing_image_fraction * total) {
+    std::ostringstream message;
+    message << missing << " of " << total
+            << " images are missing (more than max_missing_image_fraction = "
+            << options.max_missing_image_fraction
+            << "); first: " << first_missing;
+    throw InputError(manifest.exposures, 0, message.str());
+  }
+
+  for (size_t p = 0; p < survey.rig.stereo_pairs.size(); ++p) {
+    const std::array<int, 2>& pair = survey.rig.stereo_pairs[p];
+    bool usable = false;
+    for (const Exposure& exposure : survey.exposures.exposures) {
+      const int left = exposure.image_of_camera[pair[0]];
+      const int right = exposure.image_of_camera[pair[1]];
+      if (left >= 0 && right >= 0 && present[left] && present[right]) {
+        usable = true;
+        break;
+      }
+    }
+    if (!usable) {
+      throw InputError(
+          manifest.exposures, 0,
+          "stereo pair " + std::to_string(p) + " (" +
+              survey.rig.cameras[pair[0]].camera.name() + ", " +
+              survey.rig.cameras[pair[1]].camera.name() +
+              "): no exposure has existing images of both cameras");
+    }
+  }
+
+  if (options.load_roadmarks) {
+    survey.roadmarks =
+        ReadRoadmarks(survey.PathOf(manifest.roadmarks), manifest.roadmarks);
+  }
+  return survey;
+}
+
+}  // namespace zebrageo

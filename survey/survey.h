@@ -1,0 +1,67 @@
+// A survey folder (SURVEY_FORMAT.md): the manifest and everything it names,
+// loaded and validated.
+#ifndef ZEBRAGEO_SURVEY_SURVEY_H_
+#define ZEBRAGEO_SURVEY_SURVEY_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "survey/exposures.h"
+#include "survey/geodesy.h"
+#include "survey/rig.h"
+#include "survey/roadmarks.h"
+#include "survey/trajectory.h"
+
+namespace zebrageo {
+
+struct SurveyManifest {
+  std::string name;
+  std::string rig = "rig.yaml";  // paths relative to the survey folder
+  std::string trajectory = "trajectory.csv";
+  std::string exposures = "exposures.csv";
+  std::string roadmarks = "roadmarks.geojson";
+  std::optional<Geodetic> origin;  // default: the first trajectory sample
+};
+
+// Reads survey.yaml. Throws InputError for malformed YAML, a missing key, an
+// origin that is not 3 finite numbers, or a named file that does not exist.
+SurveyManifest ReadManifest(const std::string& survey_folder);
+void WriteManifest(const SurveyManifest& manifest, const std::string& path);
+
+struct SurveyLoadOptions {
+  // Load roadmarks.geojson (match and adjust need it; reconstruct does not).
+  bool load_roadmarks = true;
+  // Share of images that may be missing before the survey is rejected; a few
+  // missing images only produce warnings (SURVEY_FORMAT.md).
+  double max_missing_image_fraction = 0.2;
+
+  std::string Check() const;
+};
+
+struct Survey {
+  std::string folder;
+  SurveyManifest manifest;
+  Rig rig;
+  LocalFrame frame{Geodetic{}};
+  Trajectory trajectory;
+  ExposureTable exposures;
+  RoadmarkDatabase roadmarks;
+  // Problems that do not stop processing (missing images...), for report.json.
+  std::vector<std::string> warnings;
+
+  // Absolute path of a file named relative to the survey folder.
+  std::string PathOf(const std::string& relative) const;
+};
+
+// Loads and cross-validates a survey. Throws InputError: everything the
+// individual readers reject, plus exposures outside the trajectory's time
+// span, too many missing images, a rig without stereo pairs, a stereo pair
+// none of whose exposures has both images. Throws std::invalid_argument when
+// `options.Check()` fails.
+Survey LoadSurvey(const std::string& folder,
+                  const SurveyLoadOptions& options = SurveyLoadOptions());
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_SURVEY_SURVEY_H_

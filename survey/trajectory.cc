@@ -1,0 +1,195 @@
+#include "survey/trajectory.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "survey/atomic_file.h"
+#include "survey/csv.h"
+#include "survey/input_error.h"
+
+namespace zebrageo {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+
+const std::vector<std::string>& TrajectoryColumns() {
+  static const std::vector<std::string> kColumns = {
+      "time", "lat",  "lon",  "h",       "roll",     "pitch",     "heading",
+      "sd_e", "sd_n", "sd_u", "sd_roll", "sd_pitch", "sd_heading"};
+  return kColumns;
+}
+
+std::vector<TrajectorySample> SamplesFromTable(const CsvTable& table) {
+  std::vector<TrajectorySample> samples;
+  samples.reserve(table.NumRows());
+  for (int row = 0; row < table.NumRows(); ++row) {
+    TrajectorySample s;
+    s.time = table.GetDouble(row, "time");
+    s.position.lat_deg = table.GetDouble(row, "lat");
+    s.position.lon_deg = table.GetDouble(row, "lon");
+    s.position.h_m = table.GetDouble(row, "h");
+    s.attitude.roll = table.GetDouble(row, "roll") * kDegToRad;
+    s.attitude.pitch = table.GetDouble(row, "pitch") * kDegToRad;
+    s.attitude.heading = table.GetDouble(row, "heading") * kDegToRad;
+    s.sd_enu_m = {table.GetDouble(row, "sd_e"), table.GetDouble(row, "sd_n"),
+                  table.GetDouble(row, "sd_u")};
+    s.sd_attitude_rad = {table.GetDouble(row, "sd_roll") * kDegToRad,
+                         table.GetDouble(row, "sd_pitch") * kDegToRad,
+                         table.GetDouble(row, "sd_heading") * kDegToRad};
+    if (std::abs(s.position.lat_deg) > 90.0) {
+      table.Fail(row, "latitude " + FormatDouble(s.position.lat_deg) +
+                          " is outside [-90, 90]");
+    }
+    if (std::abs(s.position.lon_deg) > 180.0) {
+      table.Fail(row, "longitude " + FormatDouble(s.position.lon_deg) +
+                          " is outside [-180, 180]");
+    }
+    if (std::abs(table.GetDouble(row, "pitch")) > 90.0) {
+      table.Fail(row, "pitch " + table.GetString(row, "pitch") +
+                          " is outside [-90, 90] degrees");
+    }
+    if ((s.sd_enu_m.array() < 0.0).any() ||
+        (s.sd_attitude_rad.array() < 0.0).any()) {
+      table.Fail(row, "a standard deviation (sd_*) is negative");
+    }
+    if (!samples.empty() && !(s.time > samples.back().time)) {
+      table.Fail(row, "time " + FormatDouble(s.time) +
+                          (s.time == samples.back().time
+                               ? " repeats the previous sample's time"
+                               : " is earlier than the previous sample's " +
+                                     FormatDouble(samples.back().time)) +
+                          ": times must increase strictly");
+    }
+    samples.push_back(s);
+  }
+  if (samples.size() < 2) {
+    throw InputError(
+        table.display_name(), 0,
+        "needs at least 2 samples, has " + std::to_string(samples.size()));
+  }
+  return samples;
+}
+
+// Wraps an angle in degrees into (-180, 180].
+double WrapDegrees180(double degrees) {
+  double wrapped = std::remainder(degrees, 360.0);
+  if (wrapped <= -180.0) wrapped += 360.0;
+  return wrapped;
+}
+
+}  // namespace
+
+Eigen::Isometry3d Pose::T_enu_body() const {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = q_enu_body.toRotationMatrix();
+  T.translation() = p_enu;
+  return T;
+}
+
+Pose Pose::FromIsometry(const Eigen::Isometry3d& T_enu_body) {
+  Pose pose;
+  pose.q_enu_body = Eigen::Quaterniond(T_enu_body.linear()).normalized();
+  pose.p_enu = T_enu_body.translation();
+  return pose;
+}
+
+Pose InterpolatePoses(const Pose& a, const Pose& b, double u) {
+  Pose pose;
+  pose.p_enu = (1.0 - u) * a.p_enu + u * b.p_enu;
+  // Eigen's slerp takes the shorter arc (it flips the sign of b if needed).
+  pose.q_enu_body = a.q_enu_body.slerp(u, b.q_enu_body).normalized();
+  return pose;
+}
+
+Trajectory::Trajectory(std::vector<TrajectorySample> samples,
+                       const LocalFrame& frame)
+    : samples_(std::move(samples)) {
+  CHECK_GE(samples_.size(), 2u);
+  poses_.reserve(samples_.size());
+  for (size_t i = 0; i < samples_.size(); ++i) {
+    if (i > 0) CHECK_GT(samples_[i].time, samples_[i - 1].time);
+    const TrajectorySample& s = samples_[i];
+    Pose pose;
+    pose.p_enu = frame.EnuFromGeodetic(s.position);
+    pose.q_enu_body =
+        Eigen::Quaterniond(frame.RotationEnuFromBody(s.position, s.attitude));
+    poses_.push_back(pose);
+  }
+}
+
+int Trajectory::FindSegment(double time) const {
+  if (!Covers(time)) return -1;
+  const auto upper = std::upper_bound(
+      samples_.begin(), samples_.end(), time,
+      [](double t, const TrajectorySample& s) { return t < s.time; });
+  const int index = static_cast<int>(upper - samples_.begin()) - 1;
+  return std::min(index, size() - 2);
+}
+
+bool Trajectory::InterpolatePose(double time, Pose* pose) const {
+  const int i = FindSegment(time);
+  if (i < 0) return false;
+  const double t0 = samples_[i].time;
+  const double t1 = samples_[i + 1].time;
+  *pose = InterpolatePoses(poses_[i], poses_[i + 1], (time - t0) / (t1 - t0));
+  return true;
+}
+
+std::vector<TrajectorySample> ReadTrajectorySamples(
+    const std::string& path, const std::string& display_name) {
+  return SamplesFromTable(
+      CsvTable::Read(path, display_name, TrajectoryColumns()));
+}
+
+std::vector<TrajectorySample> ParseTrajectorySamples(
+    const std::string& text, const std::string& display_name) {
+  return SamplesFromTable(
+      CsvTable::Parse(text, display_name, TrajectoryColumns()));
+}
+
+void WriteTrajectorySamples(const std::vector<TrajectorySample>& samples,
+                            const std::string& path) {
+  constexpr double kRadToDeg = 180.0 / kPi;
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    CsvWriter csv(&out);
+    csv.Header(TrajectoryColumns());
+    for (const TrajectorySample& s : samples) {
+      double heading = std::fmod(s.attitude.heading * kRadToDeg, 360.0);
+      if (heading < 0.0) heading += 360.0;
+      if (heading >= 360.0) heading -= 360.0;
+      csv.Add(s.time)
+          .Add(s.position.lat_deg)
+          .Add(s.position.lon_deg)
+          .Add(s.position.h_m)
+          .Add(WrapDegrees180(s.attitude.roll * kRadToDeg))
+          .Add(std::clamp(s.attitude.pitch * kRadToDeg, -90.0, 90.0))
+          .Add(heading)
+          .Add(s.sd_enu_m.x())
+          .Add(s.sd_enu_m.y())
+          .Add(s.sd_enu_m.z())
+          .Add(s.sd_attitude_rad.x() * kRadToDeg)
+          .Add(s.sd_attitude_rad.y() * kRadToDeg)
+          .Add(s.sd_attitude_rad.z() * kRadToDeg);
+      csv.EndRow();
+    }
+  });
+}
+
+TrajectorySample SampleFromPose(double time, const Pose& pose,
+                                const LocalFrame& frame,
+                                const Eigen::Vector3d& sd_enu_m,
+                                const Eigen::Vector3d& sd_attitude_rad) {
+  TrajectorySample sample;
+  sample.time = time;
+  sample.position = frame.GeodeticFromEnu(pose.p_enu);
+  sample.attitude = frame.AttitudeFromRotationEnuBody(
+      sample.position, pose.q_enu_body.toRotationMatrix());
+  sample.sd_enu_m = sd_enu_m;
+  sample.sd_attitude_rad = sd_attitude_rad;
+  return sample;
+}
+
+}  // namespace zebrageo

@@ -1,0 +1,107 @@
+#include "survey/image_io.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+
+#include "survey/input_error.h"
+#include "tests/survey/test_util.h"
+
+namespace zebrageo {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string ErrorOfRead(const std::string& path, int width = 0,
+                        int height = 0) {
+  try {
+    ReadGrayImage(path, "images/x.png", width, height);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "(no InputError)";
+}
+
+TEST(ReadGrayImage, Reads8BitGreyAsFloat) {
+  TemporaryFolder folder;
+  cv::Mat image(3, 4, CV_8UC1);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) image.at<uint8_t>(r, c) = 20 * r + c;
+  }
+  const std::string path = folder.Path("grey.png");
+  ASSERT_TRUE(cv::imwrite(path, image));
+  const cv::Mat read = ReadGrayImage(path, "grey.png", 4, 3);
+  ASSERT_EQ(read.type(), CV_32FC1);
+  EXPECT_EQ(read.cols, 4);
+  EXPECT_EQ(read.rows, 3);
+  EXPECT_EQ(read.at<float>(2, 3), 43.0f);
+  EXPECT_EQ(read.at<float>(0, 0), 0.0f);
+}
+
+TEST(ReadGrayImage, Scales16BitTo255) {
+  TemporaryFolder folder;
+  cv::Mat image(2, 2, CV_16UC1, cv::Scalar(0));
+  image.at<uint16_t>(0, 1) = 65535;
+  image.at<uint16_t>(1, 0) = 257 * 100;
+  for (const char* name : {"deep.png", "deep.tif"}) {
+    const std::string path = folder.Path(name);
+    ASSERT_TRUE(cv::imwrite(path, image));
+    const cv::Mat read = ReadGrayImage(path, name);
+    ASSERT_EQ(read.type(), CV_32FC1) << name;
+    EXPECT_NEAR(read.at<float>(0, 1), 255.0f, 1e-4) << name;
+    EXPECT_NEAR(read.at<float>(1, 0), 100.0f, 1e-4) << name;
+    EXPECT_EQ(read.at<float>(0, 0), 0.0f) << name;
+  }
+}
+
+TEST(ReadGrayImage, ConvertsColourToLuminance) {
+  TemporaryFolder folder;
+  // BGR: pure red, pure green, pure blue, white.
+  cv::Mat image(1, 4, CV_8UC3);
+  image.at<cv::Vec3b>(0, 0) = cv::Vec3b(0, 0, 200);
+  image.at<cv::Vec3b>(0, 1) = cv::Vec3b(0, 200, 0);
+  image.at<cv::Vec3b>(0, 2) = cv::Vec3b(200, 0, 0);
+  image.at<cv::Vec3b>(0, 3) = cv::Vec3b(255, 255, 255);
+  const std::string path = folder.Path("colour.png");
+  ASSERT_TRUE(cv::imwrite(path, image));
+  const cv::Mat read = ReadGrayImage(path, "colour.png");
+  ASSERT_EQ(read.type(), CV_32FC1);
+  // ITU-R BT.601 weights, as cv::cvtColor.
+  EXPECT_NEAR(read.at<float>(0, 0), 0.299f * 200, 0.01);
+  EXPECT_NEAR(read.at<float>(0, 1), 0.587f * 200, 0.01);
+  EXPECT_NEAR(read.at<float>(0, 2), 0.114f * 200, 0.01);
+  EXPECT_NEAR(read.at<float>(0, 3), 255.0f, 0.01);
+}
+
+TEST(ReadGrayImage, RejectsAMissingFile) {
+  TemporaryFolder folder;
+  EXPECT_THAT(ErrorOfRead(folder.Path("absent.png")),
+              HasSubstr("images/x.png: image file does not exist"));
+}
+
+TEST(ReadGrayImage, RejectsGarbageBytes) {
+  TemporaryFolder folder;
+  const std::string path = folder.Write(
+      "garbage.png", std::string("\x89PNG\r\n\x1a\n\x01\x02garbage", 18));
+  EXPECT_THAT(ErrorOfRead(path),
+              HasSubstr("images/x.png: cannot decode image (not a PNG/TIFF?)"));
+  const std::string text = folder.Write("text.png", "hello, world\n");
+  EXPECT_THAT(ErrorOfRead(text), HasSubstr("cannot decode image"));
+  const std::string empty = folder.Write("empty.png", "");
+  EXPECT_THAT(ErrorOfRead(empty), HasSubstr("cannot decode image"));
+}
+
+TEST(ReadGrayImage, RejectsAnImageOfTheWrongSize) {
+  TemporaryFolder folder;
+  const std::string path = folder.Path("small.png");
+  ASSERT_TRUE(cv::imwrite(path, cv::Mat(48, 64, CV_8UC1, cv::Scalar(7))));
+  EXPECT_THAT(ErrorOfRead(path, 1920, 1080),
+              HasSubstr("images/x.png: image is 64x48 pixels but the rig's "
+                        "camera is 1920x1080"));
+  EXPECT_EQ(ReadGrayImage(path, "small.png", 64, 48).at<float>(0, 0), 7.0f);
+}
+
+}  // namespace
+}  // namespace zebrageo

@@ -1,0 +1,49 @@
+// The subcommands of `zebrageo`. Each adds itself to the CLI11 app and, when
+// chosen, runs by calling the libraries: no algorithm lives in tools/.
+#ifndef ZEBRAGEO_TOOLS_COMMANDS_H_
+#define ZEBRAGEO_TOOLS_COMMANDS_H_
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace zebrageo {
+
+struct Command {
+  CLI::App* subcommand = nullptr;
+  // Runs the command after parsing. Throws InputError, NotImplementedError
+  // or StageFailedError; main maps them to exit codes.
+  std::function<void()> run;
+};
+
+void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands);
+void AddCheckCommand(CLI::App* app, std::vector<Command>* commands);
+// One file per stage command: tools/<stage>_command.cc.
+void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands);
+void AddMatchCommand(CLI::App* app, std::vector<Command>* commands);
+void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands);
+// run and report.
+void AddRunCommands(CLI::App* app, std::vector<Command>* commands);
+
+// The arguments every stage command takes: SURVEY -o RESULTS.
+struct StageArguments {
+  std::string survey;
+  std::string results;
+};
+// Adds a stage subcommand with its two arguments bound to `args`.
+CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
+                             const std::string& description,
+                             StageArguments* args);
+// A runner for a stage that is not built yet: it validates the survey (so
+// the user learns whether it is readable), then throws NotImplementedError.
+std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,
+                                          const std::string& stage,
+                                          const std::string& issue);
+void AddImportOpenCvStereoCommand(CLI::App* app,
+                                  std::vector<Command>* commands);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_TOOLS_COMMANDS_H_

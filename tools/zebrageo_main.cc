@@ -1,0 +1,97 @@
+// zebrageo: georeferences mobile-mapping surveys with zebra crossings as
+// ground control. `zebrageo --help` lists the commands.
+#include <glog/logging.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "survey/input_error.h"
+#include "tools/commands.h"
+#include "tools/exit_codes.h"
+#include "tools/version.h"
+
+namespace zebrageo {
+namespace {
+
+void ConfigureLogging(const std::string& level, int verbosity) {
+  FLAGS_logtostderr = true;
+  FLAGS_colorlogtostderr = false;
+  if (level == "error") FLAGS_minloglevel = google::GLOG_ERROR;
+  if (level == "warning") FLAGS_minloglevel = google::GLOG_WARNING;
+  if (level == "info" || level == "debug")
+    FLAGS_minloglevel = google::GLOG_INFO;
+  FLAGS_v = level == "debug" ? std::max(1, verbosity) : verbosity;
+}
+
+int Fail(ExitCode code, const std::string& message) {
+  std::cerr << "zebrageo: error: " << message << std::endl;
+  return code;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{
+      "zebrageo " ZEBRAGEO_VERSION_STRING
+      ": centimetre georeferencing of mobile-mapping surveys, with zebra "
+      "crossings as ground control points."};
+  app.set_version_flag("--version", "zebrageo " ZEBRAGEO_VERSION_STRING);
+  app.require_subcommand(1);
+  std::string log_level = "info";
+  int verbosity = 0;
+  app.add_option("--log-level", log_level, "error, warning, info or debug")
+      ->check(CLI::IsMember({"error", "warning", "info", "debug"}))
+      ->capture_default_str();
+  app.add_option("-v,--verbosity", verbosity, "detail of debug logging (VLOG)")
+      ->check(CLI::Range(0, 3));
+  app.footer(
+      "Exit status: 0 success (warnings in report.json), 1 invalid input, "
+      "2 usage, 3 stage failed, 4 not implemented, 5 internal error.");
+
+  std::vector<Command> commands;
+  AddSimulateCommand(&app, &commands);
+  AddCheckCommand(&app, &commands);
+  AddReconstructCommand(&app, &commands);
+  AddMatchCommand(&app, &commands);
+  AddAdjustCommand(&app, &commands);
+  AddRunCommands(&app, &commands);
+  AddImportOpenCvStereoCommand(&app, &commands);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  ConfigureLogging(log_level, verbosity);
+
+  try {
+    for (const Command& command : commands) {
+      if (command.subcommand->parsed()) command.run();
+    }
+  } catch (const InputError& error) {
+    return Fail(kExitBadInput, error.what());
+  } catch (const UsageError& error) {
+    return Fail(kExitUsage, error.what());
+  } catch (const NotImplementedError& error) {
+    return Fail(kExitNotImplemented, error.what());
+  } catch (const StageFailedError& error) {
+    return Fail(kExitStageFailed, error.what());
+  } catch (const std::bad_alloc&) {
+    return Fail(kExitInternalError, "out of memory");
+  } catch (const std::exception& error) {
+    return Fail(kExitInternalError, error.what());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+}  // namespace zebrageo
+
+int main(int argc, char** argv) {
+  google::InitGoogleLogging(argv[0]);
+  return zebrageo::Main(argc, argv);
+}
