@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
-# Builds and runs every test: a Release build with warnings as errors, then
-# the unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
+# Builds and runs every test: a Release build with warnings as errors, the
+# parsers' fuzzers for a bounded time, then the unit tests again under
+# AddressSanitizer + UndefinedBehaviorSanitizer (ctest's summary ends it).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(nproc)"
 
 "$here/scripts/build.sh" "$here/build" -DZEBRAGEO_WERROR=ON
 ctest --test-dir "$here/build" --output-on-failure -j "$jobs"
+
+# The parsers under libFuzzer (clang, ASan+UBSan), a bounded time each.
+"$here/scripts/fuzz.sh" "${ZEBRAGEO_FUZZ_SECONDS:-20}"
 
 # Sanitizer build: tests only (no benchmarks), Debug-like optimisation so
 # the reports point at lines, still fast enough for CI's 2 cores.
