@@ -1,23 +1,65 @@
 // `zebrageo simulate --preset NAME --seed N -o SURVEY`: writes a simulated
 // survey with its ground truth (truth/).
+#include <glog/logging.h>
+
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "survey/input_error.h"
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
+#include "tools/progress.h"
+#include "tools/simulator/simulator.h"
 
 namespace zebrageo {
+namespace {
+
+struct SimulateArguments {
+  std::string preset = "demo";
+  uint64_t seed = 1;
+  std::string output;
+  std::vector<std::string> overrides;
+  bool no_images = false;
+};
+
+}  // namespace
 
 void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
-  auto output = std::make_shared<std::string>();
+  auto args = std::make_shared<SimulateArguments>();
   CLI::App* sub = app->add_subcommand(
-      "simulate", "Write a simulated survey with its ground truth in truth/.");
-  sub->add_option("-o,--output", *output, "survey folder to write")->required();
-  sub->allow_extras();
-  commands->push_back({sub, [] {
-                         throw NotImplementedError(
-                             "the simulator is not implemented yet (issue 4)");
-                       }});
+      "simulate",
+      "Write a simulated survey (images, trajectory with GNSS/INS drift, "
+      "road-mark database) with its ground truth in truth/.");
+  sub->add_option("--preset", args->preset,
+                  "demo, urban, outage, sparse, ambiguity or large")
+      ->capture_default_str();
+  sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
+  sub->add_option("-o,--output", args->output, "survey folder to write")
+      ->required();
+  sub->add_option("--set", args->overrides,
+                  "override a knob of the preset, e.g. --set road_length_m=300 "
+                  "(repeatable; see datasets/README.md)");
+  sub->add_flag("--no-images", args->no_images,
+                "write only the geometry (no rendering)");
+  commands->push_back(
+      {sub, [args] {
+         SimulationOptions options;
+         std::string error = ApplyPreset(args->preset, &options);
+         if (!error.empty()) throw UsageError(error);
+         options.seed = args->seed;
+         for (const std::string& item : args->overrides) {
+           error = SetOption(item, &options);
+           if (!error.empty()) throw UsageError("--set " + item + ": " + error);
+         }
+         if (args->no_images) options.render_images = false;
+         error = options.Check();
+         if (!error.empty()) throw UsageError(error);
+         ProgressBar progress("simulate");
+         SimulateSurvey(options, args->output, progress.Callback());
+         progress.Finish();
+         LOG(INFO) << "wrote survey " << args->output;
+       }});
 }
 
 }  // namespace zebrageo

@@ -1,0 +1,163 @@
+// The vehicle motion, GNSS/INS error model, rig and exposure times.
+#include "tools/simulator/motion.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "tools/simulator/world.h"
+
+namespace zebrageo::sim {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+SimulationOptions MotionOptions() {
+  SimulationOptions options;
+  options.seed = 5;
+  options.road_length_m = 800.0;
+  options.num_crossings = 2;
+  options.facades = false;  // not needed here
+  return options;
+}
+
+LocalFrame FrameOf(const SimulationOptions& o) {
+  return LocalFrame(Geodetic{o.origin_lat_deg, o.origin_lon_deg, o.origin_h_m});
+}
+
+TEST(Motion, DriftStaysWithinTheRequestedPeakAndUsesMostOfIt) {
+  SimulationOptions options = MotionOptions();
+  options.drift_along_track_m = 0.6;
+  options.drift_cross_track_m = 0.8;
+  options.drift_vertical_m = 0.2;
+  const World world = BuildWorld(options);
+  const LocalFrame frame = FrameOf(options);
+  const VehicleMotion motion = SimulateMotion(options, world, frame);
+  double max_h = 0.0, max_v = 0.0;
+  for (size_t k = 0; k < motion.truth.size(); ++k) {
+    // The error is what the files say: measured minus true position.
+    const Eigen::Vector3d e =
+        frame.EnuFromGeodetic(motion.measured[k].position) -
+        frame.EnuFromGeodetic(motion.truth[k].position);
+    EXPECT_LT((e - motion.position_error_enu[k]).norm(), 1e-6);
+    max_h = std::max(max_h, e.head<2>().norm());
+    max_v = std::max(max_v, std::abs(e.z()));
+  }
+  const double peak = std::hypot(0.6, 0.8);
+  EXPECT_LE(max_h, peak + 1e-9);
+  EXPECT_GE(max_h, 0.5 * 0.8);
+  EXPECT_LE(max_v, 0.2 + 1e-9);
+  EXPECT_GE(max_v, 0.1);
+  // Optimistic sd: claimed 3 cm where the error reaches decimetres.
+  for (const TrajectorySample& s : motion.measured) {
+    EXPECT_LT(s.sd_enu_m.x(), 0.1 * max_h);
+  }
+}
+
+TEST(Motion, ErrorGrowsDuringAnOutageAndDropsWhenGnssReturns) {
+  SimulationOptions options = MotionOptions();
+  options.drift_along_track_m = 0.1;
+  options.drift_cross_track_m = 0.1;
+  options.outage_start_s = 20.0;
+  options.outage_duration_s = 40.0;
+  options.outage_drift_m = 3.0;
+  options.gnss_return_jump_m = 0.2;
+  const World world = BuildWorld(options);
+  const VehicleMotion motion = SimulateMotion(options, world, FrameOf(options));
+  ASSERT_GT(motion.outage_end_time, motion.outage_begin_time);
+  auto error_at = [&](double time) {
+    size_t k = 0;
+    while (k + 1 < motion.truth.size() && motion.truth[k].time < time) ++k;
+    return motion.position_error_enu[k].head<2>().norm();
+  };
+  const double t0 = motion.outage_begin_time;
+  const double t1 = motion.outage_end_time;
+  const double start = error_at(t0 + 0.5);
+  const double middle = error_at(0.5 * (t0 + t1));
+  const double end = error_at(t1 - 0.05);
+  const double after = error_at(t1 + 0.05);
+  EXPECT_LT(start, 0.2);
+  EXPECT_GT(middle, 0.5);        // ~3 m / 4, quadratic growth
+  EXPECT_GT(end, 2.6);           // ~3 m
+  EXPECT_LT(middle, 0.5 * end);  // quadratic, not linear
+  EXPECT_LT(after, 0.5);         // the jump back at GNSS return
+  // The claimed sd grows a little but stays optimistic.
+  size_t k = 0;
+  while (motion.truth[k].time < t1 - 0.05) ++k;
+  EXPECT_LT(motion.measured[k].sd_enu_m.x(), 0.3);
+}
+
+TEST(Motion, TruthFollowsTheRightLaneAtImuHeightWithRoadAttitude) {
+  SimulationOptions options = MotionOptions();
+  options.suspension_roll_deg = 0.0;
+  options.suspension_pitch_deg = 0.0;
+  const World world = BuildWorld(options);
+  const LocalFrame frame = FrameOf(options);
+  const VehicleMotion motion = SimulateMotion(options, world, frame);
+  for (size_t k = 0; k < motion.truth.size(); k += 97) {
+    const TrajectorySample& s = motion.truth[k];
+    const Eigen::Vector3d p = frame.EnuFromGeodetic(s.position);
+    double rs = 0.0, l = 0.0;
+    ASSERT_TRUE(
+        world.road.ToRoadCoordinates(p.head<2>(), motion.s_m[k], &rs, &l));
+    EXPECT_NEAR(l, world.lane_offset_m, 0.15);
+    EXPECT_NEAR(p.z() - world.road.Height(rs, l), options.imu_height_m, 0.03);
+    // Heading: compass angle of the road tangent (within the lane wander).
+    const double theta = world.road.Heading(rs);
+    double expected = std::fmod(90.0 - theta / kDeg + 720.0, 360.0);
+    // Relative to north at the vehicle: meridian convergence is tiny here.
+    double diff = std::remainder(s.attitude.heading / kDeg - expected, 360.0);
+    EXPECT_LT(std::abs(diff), 1.0);
+    // Roll on the right lane: the road falls to the right (right side down).
+    EXPECT_GT(s.attitude.roll, 0.5 * 0.02);
+    EXPECT_NEAR(std::tan(s.attitude.pitch), world.road.Grade(rs), 0.003);
+  }
+}
+
+TEST(Motion, ExposuresAreLabelledAndSpacedTwoToFourMetres) {
+  SimulationOptions options = MotionOptions();
+  const World world = BuildWorld(options);
+  const VehicleMotion motion = SimulateMotion(options, world, FrameOf(options));
+  ASSERT_GT(motion.exposures.size(), 100u);
+  EXPECT_EQ(motion.exposures.front().exposure_id, 1000);
+  bool gap = false;
+  for (size_t i = 1; i < motion.exposures.size(); ++i) {
+    const ExposureEvent& a = motion.exposures[i - 1];
+    const ExposureEvent& b = motion.exposures[i];
+    EXPECT_GT(b.exposure_id, a.exposure_id);
+    gap |= b.exposure_id > a.exposure_id + 1;
+    EXPECT_GT(b.time, a.time);
+    EXPECT_GE(b.s_m - a.s_m, 2.0);
+    EXPECT_LE(b.s_m - a.s_m, 4.0);
+  }
+  EXPECT_TRUE(gap) << "exposure ids must not be contiguous";
+  EXPECT_GT(motion.exposures.front().time, motion.truth.front().time);
+  EXPECT_LT(motion.exposures.back().time, motion.truth.back().time);
+}
+
+TEST(Rig, CamerasLookForwardAndDownOneMetreApart) {
+  const SimulationOptions options;
+  const Rig rig = MakeRig(options);
+  ASSERT_EQ(rig.cameras.size(), 2u);
+  EXPECT_EQ(rig.cameras[0].camera.name(), "left");
+  EXPECT_EQ(rig.cameras[1].camera.name(), "right");
+  ASSERT_EQ(rig.stereo_pairs.size(), 1u);
+  const Eigen::Vector3d baseline = rig.cameras[1].T_body_cam.translation() -
+                                   rig.cameras[0].T_body_cam.translation();
+  EXPECT_NEAR(baseline.y(), 1.0, 0.02);  // right camera to the right (+y)
+  for (const RigCamera& c : rig.cameras) {
+    const Eigen::Vector3d axis = c.T_body_cam.linear().col(2);  // optical
+    EXPECT_GT(axis.x(), 0.9);                                   // forward
+    EXPECT_NEAR(std::asin(axis.z()) / kDeg, 20.0,
+                1.0);  // pitched down (z down)
+    EXPECT_NEAR(c.T_body_cam.translation().z(),
+                -(options.camera_height_m - options.imu_height_m), 1e-9);
+    const Eigen::Matrix3d R = c.T_body_cam.linear();
+    EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace zebrageo::sim

@@ -1,0 +1,317 @@
+#include "tools/simulator/motion.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "tools/simulator/noise.h"
+
+namespace zebrageo::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+// Half the distance between the wheels, for the roll on the camber.
+constexpr double kHalfTrackM = 0.8;
+
+enum Purpose : uint64_t {
+  kSpeedSeed = 20,
+  kSuspensionSeed = 21,
+  kDriftSeed = 22,
+  kOutageSeed = 23,
+  kExposureSeed = 24,
+  kRigSeed = 25,
+};
+
+// A smooth random signal: a sum of sinusoids with periods in
+// [min_period, 4 min_period], scaled so that its peak over `times` is 1.
+class SmoothSignal {
+ public:
+  SmoothSignal(double min_period_s, std::mt19937_64* rng) {
+    for (int i = 0; i < 4; ++i) {
+      Wave w;
+      w.amplitude = Uniform(rng, 0.3, 1.0);
+      w.omega = 2.0 * kPi / (min_period_s * Uniform(rng, 1.0, 4.0));
+      w.phase = Uniform(rng, 0.0, 2.0 * kPi);
+      waves_.push_back(w);
+    }
+  }
+  void Normalise(const std::vector<double>& times) {
+    double peak = 0.0;
+    for (double t : times) peak = std::max(peak, std::abs(Raw(t)));
+    scale_ = peak > 0.0 ? 1.0 / peak : 0.0;
+  }
+  double operator()(double t) const { return scale_ * Raw(t); }
+
+ private:
+  struct Wave {
+    double amplitude, omega, phase;
+  };
+  double Raw(double t) const {
+    double sum = 0.0;
+    for (const Wave& w : waves_)
+      sum += w.amplitude * std::sin(w.omega * t + w.phase);
+    return sum;
+  }
+  std::vector<Wave> waves_;
+  double scale_ = 1.0;
+};
+
+// A drift component: constant part (bias_share of the peak, random sign)
+// plus a smooth variation; |value| <= peak.
+class Drift {
+ public:
+  Drift(double peak, double bias_share, double min_period_s,
+        std::mt19937_64* rng)
+      : peak_(peak),
+        bias_(bias_share * (Bernoulli(rng, 0.5) ? 1.0 : -1.0)),
+        variation_share_(1.0 - bias_share),
+        signal_(min_period_s, rng) {}
+  void Normalise(const std::vector<double>& times) { signal_.Normalise(times); }
+  double operator()(double t) const {
+    return peak_ * (bias_ + variation_share_ * signal_(t));
+  }
+
+ private:
+  double peak_;
+  double bias_;
+  double variation_share_;
+  SmoothSignal signal_;
+};
+
+Eigen::Matrix3d GeometricRotationEnuBody(double theta, double pitch,
+                                         double roll) {
+  Attitude attitude;
+  attitude.roll = roll;
+  attitude.pitch = pitch;
+  attitude.heading = 0.5 * kPi - theta;  // compass heading of the tangent
+  return RotationEnuFromNed() * RotationNedFromBody(attitude);
+}
+
+}  // namespace
+
+VehicleMotion SimulateMotion(const SimulationOptions& options,
+                             const World& world, const LocalFrame& frame) {
+  const Road& road = world.road;
+  const double dt = 1.0 / options.trajectory_rate_hz;
+  VehicleMotion motion;
+
+  // Speed profile and distance travelled, sample by sample.
+  std::mt19937_64 speed_rng(SubSeed(options.seed, kSpeedSeed));
+  SmoothSignal speed_wave(25.0, &speed_rng);
+  SmoothSignal wander(12.0, &speed_rng);
+  std::vector<double> probe_times;
+  for (double t = 0.0; t < 4000.0; t += 1.0) probe_times.push_back(t);
+  speed_wave.Normalise(probe_times);
+  wander.Normalise(probe_times);
+  auto speed = [&](double t) {
+    return options.vehicle_speed_mps *
+           (1.0 + options.speed_variation * speed_wave(t));
+  };
+  std::vector<double> times;
+  std::vector<double> s_of;
+  double s = world.s_drive_start;
+  double t_rel = 0.0;
+  for (int k = 0;; ++k) {
+    t_rel = k * dt;
+    times.push_back(t_rel);
+    s_of.push_back(s);
+    if (s >= world.s_drive_end) break;
+    s += 0.5 * (speed(t_rel) + speed(t_rel + dt)) * dt;
+  }
+  const int n = static_cast<int>(times.size());
+  const double duration = times.back();
+
+  // Suspension: two incommensurate sinusoids per axis, and heave.
+  std::mt19937_64 susp_rng(SubSeed(options.seed, kSuspensionSeed));
+  const double f = options.suspension_frequency_hz;
+  double phase[6];
+  for (double& p : phase) p = Uniform(&susp_rng, 0.0, 2.0 * kPi);
+  auto roll_osc = [&](double t) {
+    return options.suspension_roll_deg * kDegToRad *
+           (std::sin(2 * kPi * f * t + phase[0]) +
+            0.4 * std::sin(2 * kPi * 1.63 * f * t + phase[1])) /
+           1.4;
+  };
+  auto pitch_osc = [&](double t) {
+    return options.suspension_pitch_deg * kDegToRad *
+           (std::sin(2 * kPi * 0.83 * f * t + phase[2]) +
+            0.4 * std::sin(2 * kPi * 1.37 * f * t + phase[3])) /
+           1.4;
+  };
+  auto heave = [&](double t) {
+    return 0.008 * std::sin(2 * kPi * 1.1 * f * t + phase[4]);
+  };
+
+  // Errors.
+  std::mt19937_64 drift_rng(SubSeed(options.seed, kDriftSeed));
+  const double bias = options.drift_bias_share;
+  const double period = options.drift_period_s;
+  Drift along(options.drift_along_track_m, bias, period, &drift_rng);
+  Drift across(options.drift_cross_track_m, bias, period, &drift_rng);
+  Drift vertical(options.drift_vertical_m, bias, period, &drift_rng);
+  Drift heading_error(options.heading_drift_deg * kDegToRad, 0.3, period,
+                      &drift_rng);
+  Drift roll_error(options.tilt_drift_deg * kDegToRad, 0.3, period, &drift_rng);
+  Drift pitch_error(options.tilt_drift_deg * kDegToRad, 0.3, period,
+                    &drift_rng);
+  for (Drift* d : {&along, &across, &vertical, &heading_error, &roll_error,
+                   &pitch_error}) {
+    d->Normalise(times);
+  }
+  std::mt19937_64 outage_rng(SubSeed(options.seed, kOutageSeed));
+  const double outage_angle = Uniform(&outage_rng, 0.0, 2.0 * kPi);
+  const Eigen::Vector3d outage_direction(
+      std::cos(outage_angle), std::sin(outage_angle),
+      0.3 * (Bernoulli(&outage_rng, 0.5) ? 1.0 : -1.0));
+  const double jump_angle = Uniform(&outage_rng, 0.0, 2.0 * kPi);
+  const Eigen::Vector3d jump_direction(std::cos(jump_angle),
+                                       std::sin(jump_angle),
+                                       Uniform(&outage_rng, -0.5, 0.5));
+  const bool has_outage = options.outage_duration_s > 0.0;
+  const double outage_begin = options.outage_start_s;
+  const double outage_end = options.outage_start_s + options.outage_duration_s;
+  const double t0 = options.start_time_s;
+  if (has_outage) {
+    motion.outage_begin_time = t0 + outage_begin;
+    motion.outage_end_time = t0 + outage_end;
+  }
+
+  motion.truth.reserve(n);
+  motion.measured.reserve(n);
+  for (int k = 0; k < n; ++k) {
+    const double t = times[k];
+    const double sk = s_of[k];
+    // Lateral wander in the lane, and the yaw it implies.
+    const double l = world.lane_offset_m + 0.08 * wander(t);
+    const double dl_dt = 0.08 * (wander(t + 0.01) - wander(t - 0.01)) / 0.02;
+    const double theta = road.Heading(sk) + std::atan2(dl_dt, speed(t));
+    const double pitch = std::atan(road.Grade(sk)) + pitch_osc(t);
+    const double roll = std::atan2(road.Height(sk, l + kHalfTrackM) -
+                                       road.Height(sk, l - kHalfTrackM),
+                                   2.0 * kHalfTrackM) +
+                        roll_osc(t);
+    const Eigen::Matrix3d R_enu_body =
+        GeometricRotationEnuBody(theta, pitch, roll);
+    const Eigen::Vector3d p_enu =
+        road.SurfacePoint(sk, l) +
+        R_enu_body * Eigen::Vector3d(0.0, 0.0, -options.imu_height_m) +
+        Eigen::Vector3d(0.0, 0.0, heave(t));
+
+    TrajectorySample truth;
+    truth.time = t0 + t;
+    truth.position = frame.GeodeticFromEnu(p_enu);
+    truth.attitude =
+        frame.AttitudeFromRotationEnuBody(truth.position, R_enu_body);
+    motion.truth.push_back(truth);
+    motion.s_m.push_back(sk);
+
+    // Position error: drift in the road frame at the vehicle, outage growth,
+    // jump at GNSS return.
+    const Eigen::Vector2d tangent = road.Tangent(sk);
+    const Eigen::Vector2d normal = road.LeftNormal(sk);
+    const Eigen::Vector2d horizontal = along(t) * tangent + across(t) * normal;
+    Eigen::Vector3d error(horizontal.x(), horizontal.y(), vertical(t));
+    double outage_fraction = 0.0;
+    double extra_heading = 0.0;
+    if (has_outage && t >= outage_begin && t < outage_end) {
+      outage_fraction = (t - outage_begin) / options.outage_duration_s;
+      error += options.outage_drift_m * outage_fraction * outage_fraction *
+               outage_direction;
+      extra_heading = options.heading_drift_deg * kDegToRad * outage_fraction;
+    }
+    if (has_outage && t >= outage_end) {
+      error += options.gnss_return_jump_m * std::exp(-(t - outage_end) / 20.0) *
+               jump_direction;
+    }
+    const Eigen::Vector3d attitude_error(roll_error(t), pitch_error(t),
+                                         heading_error(t) + extra_heading);
+    TrajectorySample measured;
+    measured.time = truth.time;
+    measured.position = frame.GeodeticFromEnu(p_enu + error);
+    measured.attitude.roll = truth.attitude.roll + attitude_error.x();
+    measured.attitude.pitch = truth.attitude.pitch + attitude_error.y();
+    measured.attitude.heading = truth.attitude.heading + attitude_error.z();
+    const double grow = 0.2 * outage_fraction;
+    measured.sd_enu_m = Eigen::Vector3d(options.reported_sd_horizontal_m + grow,
+                                        options.reported_sd_horizontal_m + grow,
+                                        options.reported_sd_vertical_m + grow);
+    measured.sd_attitude_rad =
+        Eigen::Vector3d(options.reported_sd_tilt_deg,
+                        options.reported_sd_tilt_deg,
+                        options.reported_sd_heading_deg) *
+        kDegToRad;
+    motion.measured.push_back(measured);
+    motion.position_error_enu.push_back(error);
+    motion.attitude_error_rad.push_back(attitude_error);
+  }
+
+  // Exposures: every exposure_spacing_m +- jitter of road, times rounded to
+  // 0.1 ms; ids start at 1000 with occasional gaps.
+  std::mt19937_64 exposure_rng(SubSeed(options.seed, kExposureSeed));
+  int64_t id = 1000;
+  double next = world.s_drive_start + 1.0;
+  int k = 0;
+  while (true) {
+    while (k + 1 < n && s_of[k + 1] < next) ++k;
+    if (k + 1 >= n) break;
+    const double u = (next - s_of[k]) / (s_of[k + 1] - s_of[k]);
+    double t = std::round((times[k] + u * dt) * 1e4) / 1e4;
+    t = std::clamp(t, times.front() + 1e-4, duration - 1e-4);
+    motion.exposures.push_back({id, t0 + t, next});
+    id += Bernoulli(&exposure_rng, 0.05) ? UniformInt(&exposure_rng, 2, 6) : 1;
+    next += options.exposure_spacing_m +
+            Uniform(&exposure_rng, -options.exposure_spacing_jitter_m,
+                    options.exposure_spacing_jitter_m);
+  }
+  return motion;
+}
+
+Rig MakeRig(const SimulationOptions& options) {
+  std::mt19937_64 rng(SubSeed(options.seed, kRigSeed));
+  Rig rig;
+  const double alpha = options.camera_pitch_down_deg * kDegToRad;
+  // Camera axes in the body (FRD): x_cam = right, z_cam = forward pitched
+  // down by alpha, y_cam = z_cam x x_cam (down-ish).
+  Eigen::Matrix3d R_body_cam_nominal;
+  R_body_cam_nominal.col(0) = Eigen::Vector3d(0.0, 1.0, 0.0);
+  R_body_cam_nominal.col(1) =
+      Eigen::Vector3d(-std::sin(alpha), 0.0, std::cos(alpha));
+  R_body_cam_nominal.col(2) =
+      Eigen::Vector3d(std::cos(alpha), 0.0, std::sin(alpha));
+  const char* names[2] = {"left", "right"};
+  for (int c = 0; c < 2; ++c) {
+    const double side = c == 0 ? -0.5 : 0.5;
+    const double m = options.camera_misalignment_deg * kDegToRad;
+    const Eigen::Matrix3d misalignment =
+        (Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitZ()))
+            .toRotationMatrix();
+    RigCamera camera;
+    camera.T_body_cam.linear() = R_body_cam_nominal * misalignment;
+    camera.T_body_cam.translation() = Eigen::Vector3d(
+        options.camera_forward_m + Uniform(&rng, -0.01, 0.01),
+        side * options.stereo_baseline_m + Uniform(&rng, -0.005, 0.005),
+        -(options.camera_height_m - options.imu_height_m));
+    const double scale = c == 0 ? 1.0 : Uniform(&rng, 0.995, 1.005);
+    const double fx = options.focal_px * scale;
+    const double fy = fx * Uniform(&rng, 0.999, 1.001);
+    const double cx =
+        0.5 * (options.image_width - 1) + Uniform(&rng, -8.0, 8.0);
+    const double cy =
+        0.5 * (options.image_height - 1) + Uniform(&rng, -8.0, 8.0);
+    const double d = c == 0 ? 1.0 : Uniform(&rng, 0.97, 1.03);
+    camera.camera = Camera(names[c], options.image_width, options.image_height,
+                           fx, fy, cx, cy,
+                           {options.k1 * d, options.k2 * d, options.p1 * d,
+                            options.p2 * d, options.k3 * d});
+    rig.cameras.push_back(camera);
+  }
+  rig.stereo_pairs.push_back({0, 1});
+  return rig;
+}
+
+}  // namespace zebrageo::sim

@@ -1,0 +1,315 @@
+// The survey simulator: writes a complete survey folder (SURVEY_FORMAT.md)
+// of a stereo mobile-mapping vehicle driving down a street with zebra
+// crossings, with its ground truth in truth/.
+//
+// The world lives in the survey's local ENU frame (x east, y north, z up,
+// metres) at `origin_*`. A road centreline of straights, clothoid transitions
+// and circular arcs is parameterised by arc length s; a point beside it has
+// road coordinates (s, l), l positive to the LEFT of the driving direction.
+// The road surface is z = crown_height(s) + cross_section(l): grade varies
+// smoothly along s, and the cross-section falls by `crossfall` from a rounded
+// crown on the centreline to both edges.
+//
+// Zebra bands have their long sides along the road and repeat across it.
+// Each band is the planar quad through its 4 true corners (which lie on the
+// road surface); images are ray cast per pixel through the exact inverse of
+// the OpenCV distortion, supersampled at edges, then blurred, vignetted,
+// gain-varied and noised. The measured trajectory is the true one plus a
+// GNSS/INS error (slow drift, outages, jumps, attitude drift) while its sd_*
+// stay optimistic. The road-mark database is the true corners plus noise, a
+// per-crossing offset and faults (missing, stale, repainted crossings,
+// missing bands), each recorded in truth/meta.json.
+//
+// Everything is deterministic for a given `seed`: world, errors and each
+// image's noise come from generators seeded by (seed, purpose, image index).
+#ifndef ZEBRAGEO_TOOLS_SIMULATOR_SIMULATOR_H_
+#define ZEBRAGEO_TOOLS_SIMULATOR_SIMULATOR_H_
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace zebrageo {
+
+// Bits per pixel of the written PNG images (grey).
+enum class PixelDepth { kUint8, kUint16 };
+
+struct SimulationOptions {
+  // Name of the preset the options came from (informational: survey name and
+  // truth/meta.json). ApplyPreset sets it.
+  std::string preset = "custom";
+  // Seed of every random choice. Same seed and options -> identical files.
+  uint64_t seed = 1;
+
+  // ------------------------------------------------------------ place
+  // ENU origin of the survey (written to survey.yaml): Amiens, France.
+  double origin_lat_deg = 49.8941;
+  double origin_lon_deg = 2.2958;
+  double origin_h_m = 60.0;  // ellipsoidal
+  // Heading of the road at its start, degrees clockwise from north.
+  double start_heading_deg = 65.0;
+
+  // ------------------------------------------------------------ road
+  // Length of the driven part of the road. The centreline extends 20 m
+  // before and 150 m after it so the cameras always see road ahead.
+  double road_length_m = 400.0;
+  // Kerb to kerb. Zebra crossings span it (a crossing has at most
+  // floor((road_width_m - 0.5 + band_gap_m) / (band_width_m + band_gap_m))
+  // bands, 0.25 m from the kerbs).
+  double road_width_m = 8.0;
+  // Cross slope from the crown down to both edges (0.02 = 2 %).
+  double crossfall = 0.02;
+  // Half-width of the rounding of the crown (hyperbolic profile), metres.
+  double crown_rounding_m = 0.3;
+  // Width of the sidewalk between the kerb and the facades.
+  double sidewalk_width_m = 3.0;
+  // Largest longitudinal slope (0.03 = 3 %); the grade is a sum of smooth
+  // sinusoids of wavelength >= grade_wavelength_m.
+  double max_grade = 0.03;
+  double grade_wavelength_m = 400.0;
+  // Share of the road length in curves (transitions + arcs), 0 = straight.
+  double curved_share = 0.4;
+  // Radii of the circular arcs, drawn log-uniformly between these.
+  double min_curve_radius_m = 120.0;
+  double max_curve_radius_m = 600.0;
+  // Clothoid transition at each end of an arc (0 = none).
+  double transition_length_m = 20.0;
+
+  // ------------------------------------------------------------ crossings
+  // Zebra crossings in the street (stale database crossings come on top).
+  int num_crossings = 6;
+  // Smallest distance between two crossings along the road.
+  double min_crossing_spacing_m = 40.0;
+  // Bands per crossing, also limited by the road width (see above).
+  int min_bands_per_crossing = 4;
+  int max_bands_per_crossing = 12;
+  // Band width across the road and gap between bands (the band period is
+  // their sum, ~1 m: the matching ambiguity).
+  double band_width_m = 0.5;
+  double band_gap_m = 0.5;
+  // Band length along the road, drawn per crossing.
+  double min_band_length_m = 2.5;
+  double max_band_length_m = 6.0;
+  // Probability that a crossing is skewed (its transversal direction is not
+  // perpendicular to the road: bands are parallelograms), and largest skew.
+  double skew_probability = 0.3;
+  double max_skew_deg = 25.0;
+  // Paint wear: 0 = fresh paint, 1 = paint gone at the most worn spots
+  // (contrast modulated by world-anchored noise).
+  double paint_wear = 0.3;
+  // Probability per band of a patch of missing paint.
+  double missing_paint_probability = 0.1;
+  // Probability of a stop line before a crossing, across the driving lane.
+  double stop_line_probability = 0.4;
+
+  // ------------------------------------------------------------ other marks
+  // Solid edge lines and a dashed centre line (also in the database).
+  bool lane_lines = true;
+  double lane_line_width_m = 0.15;
+  double dash_length_m = 3.0;
+  double dash_gap_m = 5.0;
+  // Oil stains and tyre marks, per 100 m of road.
+  double stains_per_100m = 4.0;
+  // Manhole covers, per 100 m of road.
+  double manholes_per_100m = 1.5;
+
+  // ------------------------------------------------------------ surroundings
+  // Buildings along both sides (vertical facades with periodic windows, a
+  // distractor that looks like zebra bands from afar).
+  bool facades = true;
+  // Horizontal period of the windows.
+  double window_period_m = 3.0;
+  // Probability of a gap (alley) after each building.
+  double facade_gap_probability = 0.15;
+  // Vehicles parked half on the sidewalk, both sides, per 100 m.
+  double parked_vehicles_per_100m = 3.0;
+  // Probability that a vehicle is parked just before a crossing, hiding its
+  // outer bands from some viewpoints.
+  double occluding_vehicle_probability = 0.3;
+  // Cast shadows of buildings and vehicles (darker ground regions).
+  bool shadows = true;
+  double sun_elevation_deg = 45.0;
+  double sun_azimuth_deg = 150.0;  // clockwise from north
+
+  // ------------------------------------------------------------ vehicle
+  // Mean speed and relative smooth variation of the speed.
+  double vehicle_speed_mps = 10.0;
+  double speed_variation = 0.15;
+  // Distance between exposures, with a uniform jitter of +- jitter.
+  double exposure_spacing_m = 3.0;
+  double exposure_spacing_jitter_m = 0.5;
+  // Height of the IMU origin above the road.
+  double imu_height_m = 1.0;
+  // Suspension oscillation amplitudes (roll, pitch) and frequency.
+  double suspension_roll_deg = 0.2;
+  double suspension_pitch_deg = 0.1;
+  double suspension_frequency_hz = 1.5;
+  // Rate of trajectory.csv and truth/trajectory.csv.
+  double trajectory_rate_hz = 100.0;
+  // Time of the first trajectory sample (GPS seconds of week).
+  double start_time_s = 302400.0;
+
+  // ------------------------------------------------------------ rig
+  // Distance between the two cameras (left, right), across the vehicle.
+  double stereo_baseline_m = 1.0;
+  // Height of the cameras above the road, and how far ahead of the IMU.
+  double camera_height_m = 2.5;
+  double camera_forward_m = 0.8;
+  // Downward pitch of the optical axes from the vehicle's forward axis.
+  double camera_pitch_down_deg = 20.0;
+  // Small rotations of each camera off the nominal mounting (realism).
+  double camera_misalignment_deg = 0.3;
+  int image_width = 1280;
+  int image_height = 960;
+  double focal_px = 1100.0;
+  // OpenCV distortion [k1, k2, p1, p2, k3] of the left camera; the right one
+  // differs by a few percent.
+  double k1 = -0.15;
+  double k2 = 0.06;
+  double p1 = 4e-4;
+  double p2 = -3e-4;
+  double k3 = -0.01;
+
+  // ------------------------------------------------------------ image
+  // Gaussian read noise and shot noise (variance shot_noise * value), grey
+  // levels on the 0..255 scale.
+  double noise_sigma = 1.5;
+  double shot_noise = 0.04;
+  // Optical blur (Gaussian), pixels.
+  double blur_sigma_px = 0.6;
+  // Relative darkening at the image corners.
+  double vignetting = 0.25;
+  // Per-image exposure gain drawn in [1 - v, 1 + v].
+  double gain_variation = 0.08;
+  PixelDepth pixel_depth = PixelDepth::kUint8;
+  // Pixels containing an edge (their 4 corner rays hit different
+  // materials) are supersampled n x n; the others average their corners.
+  int supersampling = 4;
+  // False: geometry only. exposures.csv still names the images (images/...)
+  // but no image file is written: for scaling benchmarks of the later
+  // stages, not for the full pipeline.
+  bool render_images = true;
+  // Rendering threads; 0 = hardware concurrency.
+  int threads = 0;
+
+  // ------------------------------------------------------------ GNSS/INS
+  // Peak slow drift of the measured position, in the road frame at the
+  // vehicle (along the road, across it = the band repetition direction,
+  // vertical). Each is a constant part (drift_bias_share) plus a smooth
+  // random variation with periods >= drift_period_s.
+  double drift_along_track_m = 0.4;
+  double drift_cross_track_m = 0.4;
+  double drift_vertical_m = 0.15;
+  double drift_bias_share = 0.3;
+  double drift_period_s = 60.0;
+  // Peak slow heading and tilt (roll, pitch) errors.
+  double heading_drift_deg = 0.1;
+  double tilt_drift_deg = 0.03;
+  // GNSS outage: start (seconds after the first sample) and duration
+  // (0 = none). During it the error grows quadratically to outage_drift_m
+  // (horizontal, plus 30 % of it vertically) and drops back when GNSS
+  // returns.
+  double outage_start_s = 0.0;
+  double outage_duration_s = 0.0;
+  double outage_drift_m = 1.0;
+  // Extra step of the error when GNSS returns (random direction), decaying
+  // with a 20 s time constant.
+  double gnss_return_jump_m = 0.15;
+  // What the solution claims (sd_* columns): optimistic. During an outage
+  // the claimed horizontal sd grows by at most 0.2 m.
+  double reported_sd_horizontal_m = 0.03;
+  double reported_sd_vertical_m = 0.05;
+  double reported_sd_tilt_deg = 0.01;
+  double reported_sd_heading_deg = 0.03;
+
+  // ------------------------------------------------------------ database
+  // Accuracy of the road-mark database (per axis), written as sigma_xy,
+  // sigma_z, and applied as Gaussian noise to every corner.
+  double database_sigma_xy_m = 0.04;
+  double database_sigma_z_m = 0.06;
+  // Systematic offset per crossing: horizontal magnitude drawn in
+  // [min, max] in a random direction, vertical in [-max, max].
+  double database_min_offset_m = 0.05;
+  double database_max_offset_m = 0.15;
+  // Faults: crossings in the street but not in the database; crossings in
+  // the database that no longer exist (not painted); crossings with a band
+  // worn away in the street but in the database, or painted but not in the
+  // database (always the last band, so numbering stays 1-based and
+  // consecutive in both files); crossings repainted repaint_shift_m away
+  // from where the database has them.
+  int num_missing_crossings = 0;
+  int num_stale_crossings = 1;
+  int num_missing_bands = 0;
+  int num_repainted_crossings = 0;
+  double repaint_shift_m = 0.3;
+
+  // "" when every field is valid, else one "field = value: must be ..."
+  // message per problem, joined by "; ".
+  std::string Check() const;
+};
+
+// Sets `options` to a named preset (defaults, then the preset's changes):
+//   demo       ~180 m, 3 crossings, ~55 exposures: the quick end-to-end run.
+//   urban      ~1 km, 12 crossings, facades, parked vehicles, drift to 2 m.
+//   outage     ~1.2 km with a 70 s GNSS outage, error growing to 3 m.
+//   sparse     ~1.5 km, 4 crossings far apart.
+//   ambiguity  drift of ~1 m ACROSS the road, i.e. one band period along
+//              the bands' repetition direction.
+//   large      10 km, 80 crossings, render_images = false (benchmarks).
+// Returns "" or an error naming the known presets. Keeps `seed`.
+std::string ApplyPreset(const std::string& name, SimulationOptions* options);
+std::vector<std::string> PresetNames();
+
+// Sets one field from "key=value" (every field of SimulationOptions: the
+// CLI's --set). Booleans take true/false/1/0, pixel_depth takes 8 or 16.
+// Returns "" or an error (unknown key with the list of keys, or a value that
+// does not parse). Range checks are left to Check().
+std::string SetOption(const std::string& key_equals_value,
+                      SimulationOptions* options);
+// Every settable field name, in declaration order.
+std::vector<std::string> OptionNames();
+// Every field as text, as SetOption reads it back (truth/meta.json).
+std::map<std::string, std::string> OptionValues(
+    const SimulationOptions& options);
+
+struct SimulationSummary {
+  int num_crossings_in_street = 0;
+  int num_crossings_in_database = 0;
+  int num_bands_in_street = 0;
+  int num_bands_in_database = 0;
+  int num_lines = 0;  // lane/stop line features in the database
+  int num_exposures = 0;
+  int num_images = 0;           // rows of exposures.csv
+  int num_images_rendered = 0;  // 0 when render_images is false
+  int num_trajectory_samples = 0;
+  double driven_length_m = 0.0;
+  double duration_s = 0.0;  // of the trajectory
+  // Measured minus true trajectory position, over all samples.
+  double max_horizontal_error_m = 0.0;
+  double max_vertical_error_m = 0.0;
+  double total_seconds = 0.0;
+  double render_seconds = 0.0;     // wall time of the rendering
+  double seconds_per_image = 0.0;  // CPU (thread) time per rendered image
+
+  std::string BriefReport() const;
+};
+
+// Writes the survey into `output_folder` (created if needed; existing files
+// of the same names are replaced atomically): survey.yaml, rig.yaml,
+// trajectory.csv (measured, drifting, at trajectory_rate_hz), exposures.csv,
+// images/<exposure_id>_<camera>.png, roadmarks.geojson (the database),
+// truth/trajectory.csv, truth/roadmarks.geojson (bands in the street),
+// truth/meta.json (options, crossings and their faults, error statistics,
+// "expect": "ok"). survey.yaml is written last. `progress` (may be empty) is
+// called with (images done, images total), from any thread but serialised.
+// Throws std::invalid_argument when options.Check() fails and
+// std::runtime_error when a file cannot be written.
+SimulationSummary SimulateSurvey(
+    const SimulationOptions& options, const std::string& output_folder,
+    const std::function<void(int done, int total)>& progress);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_TOOLS_SIMULATOR_SIMULATOR_H_

@@ -1,0 +1,680 @@
+#include "tools/simulator/world.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "tools/simulator/noise.h"
+
+namespace zebrageo::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+// The centreline starts kLeadIn before the driven part and ends kLookAhead
+// after it, so the cameras see road at the end of the drive.
+constexpr double kLeadInM = 20.0;
+constexpr double kLookAheadM = 150.0;
+// Distance kept between the outer bands and the kerbs.
+constexpr double kBandKerbMarginM = 0.25;
+// Offset of the edge lines from the kerbs.
+constexpr double kEdgeLineInsetM = 0.3;
+
+// Purposes of the sub-generators (SubSeed).
+enum Purpose : uint64_t {
+  kRoadSeed = 1,
+  kCrossingSeed = 2,
+  kMarksSeed = 3,
+  kDatabaseSeed = 4,
+  kBuildingSeed = 5,
+  kVehicleSeed = 6,
+  kTextureSeed = 9,
+};
+
+std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> points) {
+  std::sort(points.begin(), points.end(),
+            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+              return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+            });
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a,
+                  const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) -
+           (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
+    hull[k++] = points[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+Shadow CastShadow(const VerticalBox& box, double ground_z,
+                  const Eigen::Vector3d& sun, float factor) {
+  const double height = box.z1 - ground_z;
+  const Eigen::Vector2d offset =
+      -height * Eigen::Vector2d(sun.x(), sun.y()) / sun.z();
+  std::vector<Eigen::Vector2d> points;
+  for (const Eigen::Vector2d& p : box.Footprint()) {
+    points.push_back(p);
+    points.push_back(p + offset);
+  }
+  Shadow shadow;
+  shadow.polygon = ConvexHull(points);
+  shadow.factor = factor;
+  return shadow;
+}
+
+std::string CrossingId(int number) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "zc-%04d", number);
+  return text;
+}
+
+// The s-intervals of [s0, s1] left after removing `holes` (sorted, merged).
+std::vector<std::pair<double, double>> Subtract(
+    double s0, double s1, std::vector<std::pair<double, double>> holes) {
+  std::sort(holes.begin(), holes.end());
+  std::vector<std::pair<double, double>> out;
+  double start = s0;
+  for (const auto& [a, b] : holes) {
+    if (b <= start) continue;
+    if (a >= s1) break;
+    if (a > start) out.push_back({start, a});
+    start = std::max(start, b);
+  }
+  if (start < s1) out.push_back({start, s1});
+  return out;
+}
+
+void PlaceCrossings(const SimulationOptions& options, World* world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kCrossingSeed));
+  const Road& road = world->road;
+  const int total = options.num_crossings + options.num_stale_crossings;
+  if (total == 0) return;
+  // Stratified positions: slot i holds one crossing, at least
+  // min_crossing_spacing_m from its neighbours. The first is seen from 25 m
+  // before it, the last up to 3 m after the end of the drive.
+  const double a = world->s_drive_start + 25.0;
+  const double b = world->s_drive_end + 3.0;
+  const double slot = (b - a) / total;
+  const double spacing = std::min(options.min_crossing_spacing_m, slot);
+  std::vector<double> positions;
+  for (int i = 0; i < total; ++i) {
+    positions.push_back(a + i * slot + 0.5 * spacing +
+                        Uniform(&rng, 0.0, slot - spacing));
+  }
+  // Which slots are stale (database only), and the faults of street ones.
+  std::vector<int> order(total);
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<std::string> role(total, "ok");
+  int next = 0;
+  auto assign = [&](int count, const char* name) {
+    for (int i = 0; i < count && next < total; ++i) role[order[next++]] = name;
+  };
+  assign(options.num_stale_crossings, "stale");
+  assign(options.num_missing_crossings, "missing");
+  assign(options.num_repainted_crossings, "repainted");
+  assign(options.num_missing_bands, "missing_band");
+
+  const double width = road.width_m();
+  const double period = options.band_width_m + options.band_gap_m;
+  const int fit = static_cast<int>(std::floor(
+      (width - 2.0 * kBandKerbMarginM + options.band_gap_m) / period));
+  int number = 100 + UniformInt(&rng, 1, 20);
+  for (int i = 0; i < total; ++i) {
+    Crossing c;
+    number += UniformInt(&rng, 1, 3);  // ids are labels, with gaps
+    c.id = CrossingId(number);
+    c.salt = SubSeed(options.seed, kCrossingSeed, 1000 + i);
+    const double s_design = positions[i];
+    c.t = road.Tangent(s_design);
+    c.n = road.LeftNormal(s_design);
+    if (Bernoulli(&rng, options.skew_probability) &&
+        options.max_skew_deg > 0.0) {
+      const double lo = std::min(8.0, options.max_skew_deg);
+      c.skew_deg = Uniform(&rng, lo, options.max_skew_deg) *
+                   (Bernoulli(&rng, 0.5) ? 1.0 : -1.0);
+    }
+    c.tan_skew = std::tan(c.skew_deg * kDegToRad);
+    c.band_length_m =
+        Uniform(&rng, options.min_band_length_m, options.max_band_length_m);
+    c.band_width_m = options.band_width_m;
+    c.band_period_m = period;
+    const int most = std::min(options.max_bands_per_crossing, fit);
+    const int least = std::min(options.min_bands_per_crossing, most);
+    c.num_design_bands =
+        Bernoulli(&rng, 0.6) ? most : UniformInt(&rng, least, most);
+    const double span = c.num_design_bands * options.band_width_m +
+                        (c.num_design_bands - 1) * options.band_gap_m;
+    const double free = width - 2.0 * kBandKerbMarginM - span;
+    c.first_offset_m = -0.5 * width + kBandKerbMarginM +
+                       (free > 0.3 ? Uniform(&rng, 0.0, free) : 0.5 * free);
+    for (int k = 0; k < c.num_design_bands; ++k) {
+      c.ring_start.push_back(UniformInt(&rng, 0, 3));
+    }
+    const double angle = Uniform(&rng, 0.0, 2.0 * kPi);
+    const double magnitude = Uniform(&rng, options.database_min_offset_m,
+                                     options.database_max_offset_m);
+    c.db_offset_enu = Eigen::Vector3d(
+        magnitude * std::cos(angle), magnitude * std::sin(angle),
+        Uniform(&rng, -options.database_max_offset_m,
+                options.database_max_offset_m));
+    const double shift_along = options.repaint_shift_m *
+                               Uniform(&rng, 0.6, 1.0) *
+                               (Bernoulli(&rng, 0.5) ? 1.0 : -1.0);
+    const double shift_across =
+        options.repaint_shift_m * Uniform(&rng, -0.4, 0.4);
+    const bool long_band_worn = Bernoulli(&rng, 0.5);
+    const bool stop_line = Bernoulli(&rng, options.stop_line_probability);
+
+    c.num_street_bands = c.num_design_bands;
+    c.num_db_bands = c.num_design_bands;
+    if (role[i] == "stale") {
+      c.in_street = false;
+    } else if (role[i] == "missing") {
+      c.in_db = false;
+    } else if (role[i] == "repainted") {
+      c.repainted = true;
+      c.repaint_shift_xy = shift_along * c.t + shift_across * c.n;
+    } else if (role[i] == "missing_band") {
+      // Always the last band, so both files number 1..N consecutively.
+      if (long_band_worn) {
+        c.missing_band_kind = "worn_in_street";
+        c.num_street_bands = c.num_design_bands - 1;
+      } else {
+        c.missing_band_kind = "missing_in_db";
+        c.num_db_bands = c.num_design_bands - 1;
+      }
+    }
+    c.origin_xy = road.Centre(s_design) + c.repaint_shift_xy;
+    c.s_m = s_design + c.repaint_shift_xy.dot(c.t);
+    const double o_end =
+        c.first_offset_m + (c.num_design_bands - 1) * period + c.band_width_m;
+    const double skew_lo = std::min(c.first_offset_m, o_end) * c.tan_skew;
+    const double skew_hi = std::max(c.first_offset_m, o_end) * c.tan_skew;
+    c.s_min = c.s_m + std::min(skew_lo, skew_hi) - 0.5 * c.band_length_m;
+    c.s_max = c.s_m + std::max(skew_lo, skew_hi) + 0.5 * c.band_length_m;
+    c.stop_line = stop_line && c.in_street;
+    world->crossings.push_back(c);
+  }
+}
+
+void PaintBands(const SimulationOptions& options, World* world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kMarksSeed, 1));
+  for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
+    const Crossing& c = world->crossings[ci];
+    if (!c.in_street) continue;
+    for (int k = 1; k <= c.num_street_bands; ++k) {
+      Band band;
+      band.crossing = ci;
+      band.band = k;
+      band.corners = DesignBandCorners(world->road, c, k, c.origin_xy);
+      const auto& q = band.corners;
+      Eigen::Vector3d normal = (q[2] - q[0]).cross(q[3] - q[1]).normalized();
+      if (normal.z() < 0.0) normal = -normal;
+      const Eigen::Vector3d centroid = 0.25 * (q[0] + q[1] + q[2] + q[3]);
+      band.plane_normal = normal;
+      band.plane_offset = normal.dot(centroid);
+      band.o0 = c.first_offset_m + (k - 1) * c.band_period_m;
+      band.o1 = band.o0 + c.band_width_m;
+      if (Bernoulli(&rng, options.missing_paint_probability)) {
+        band.patch_ao =
+            Eigen::Vector2d(Uniform(&rng, -0.4, 0.4) * c.band_length_m,
+                            Uniform(&rng, band.o0, band.o1));
+        band.patch_radius_m = Uniform(&rng, 0.2, 0.6);
+      }
+      band.salt = SubSeed(options.seed, kMarksSeed, 5000 + world->bands.size());
+      world->bands.push_back(band);
+    }
+  }
+}
+
+void PaintLines(const SimulationOptions& options, World* world) {
+  const Road& road = world->road;
+  const double half = 0.5 * road.width_m();
+  std::vector<std::pair<double, double>> holes;
+  for (const Crossing& c : world->crossings) {
+    if (c.in_street) holes.push_back({c.s_min - 1.0, c.s_max + 1.0});
+  }
+  if (options.lane_lines) {
+    const double end = road.length_m();
+    for (double side : {-1.0, 1.0}) {
+      for (const auto& [a, b] : Subtract(0.5, end - 0.5, holes)) {
+        if (b - a < 1.0) continue;
+        world->lines.push_back({"lane_solid", side * (half - kEdgeLineInsetM),
+                                options.lane_line_width_m, a, b});
+      }
+    }
+    const double period = options.dash_length_m + options.dash_gap_m;
+    for (double s = 2.0; s + options.dash_length_m < end; s += period) {
+      const double s1 = s + options.dash_length_m;
+      bool clear = true;
+      for (const auto& [a, b] : holes) clear &= (s1 <= a || s >= b);
+      if (clear) {
+        world->lines.push_back(
+            {"lane_dashed", 0.0, options.lane_line_width_m, s, s1});
+      }
+    }
+  }
+  for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
+    const Crossing& c = world->crossings[ci];
+    if (!c.stop_line) continue;
+    StopLine line;
+    line.width_m = 0.3;
+    line.s_m = c.s_min - 2.0 - 0.5 * line.width_m;
+    line.l0 = -half + kEdgeLineInsetM;
+    line.l1 = -0.5 * options.lane_line_width_m - 0.05;
+    line.crossing = ci;
+    world->stop_lines.push_back(line);
+  }
+}
+
+bool NearCrossing(const World& world, double s0, double s1, double margin) {
+  for (const Crossing& c : world.crossings) {
+    if (!c.in_street) continue;
+    if (s1 > c.s_min - margin && s0 < c.s_max + margin) return true;
+  }
+  return false;
+}
+
+void PlaceSmallMarks(const SimulationOptions& options, World* world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kMarksSeed, 2));
+  const Road& road = world->road;
+  const double half = 0.5 * road.width_m();
+  const double length = road.length_m();
+  const int manholes =
+      PoissonCount(&rng, options.manholes_per_100m * length / 100.0);
+  for (int i = 0; i < manholes; ++i) {
+    for (int attempt = 0; attempt < 20; ++attempt) {
+      const double radius = Uniform(&rng, 0.3, 0.4);
+      const double s = Uniform(&rng, 1.0, length - 1.0);
+      const double l = Uniform(&rng, -half + 0.6, half - 0.6);
+      const bool square = Bernoulli(&rng, 0.3);
+      if (NearCrossing(*world, s - radius, s + radius, 1.5)) continue;
+      bool clear = true;
+      for (const LinePiece& line : world->lines) {
+        if (std::abs(l - line.l_m) < radius + 0.5 * line.width_m + 0.1 &&
+            s + radius > line.s0 && s - radius < line.s1) {
+          clear = false;
+        }
+      }
+      if (!clear) continue;
+      Manhole m;
+      m.centre = road.Centre(s) + l * road.LeftNormal(s);
+      m.radius_m = radius;
+      m.square = square;
+      m.salt = rng();
+      world->manholes.push_back(m);
+      break;
+    }
+  }
+  const int stains =
+      PoissonCount(&rng, options.stains_per_100m * length / 100.0);
+  for (int i = 0; i < stains; ++i) {
+    const double s = Uniform(&rng, 1.0, length - 1.0);
+    const double l = Uniform(&rng, -half + 0.3, half - 0.3);
+    Stain stain;
+    stain.centre = road.Centre(s) + l * road.LeftNormal(s);
+    stain.radius_m = Uniform(&rng, 0.3, 1.2);
+    stain.darkness = static_cast<float>(Uniform(&rng, 0.55, 0.85));
+    stain.salt = rng();
+    world->stains.push_back(stain);
+  }
+}
+
+void BuildFacades(const SimulationOptions& options, World* world) {
+  if (!options.facades) return;
+  std::mt19937_64 rng(SubSeed(options.seed, kBuildingSeed));
+  const Road& road = world->road;
+  const double front = 0.5 * road.width_m() + options.sidewalk_width_m;
+  for (double side : {-1.0, 1.0}) {
+    double s = -10.0;
+    while (s < road.length_m() + 10.0) {
+      const double length = Uniform(&rng, 8.0, 26.0);
+      const double depth = Uniform(&rng, 10.0, 15.0);
+      const double height = Uniform(&rng, 7.0, 20.0);
+      const double gap = Bernoulli(&rng, options.facade_gap_probability)
+                             ? Uniform(&rng, 3.0, 8.0)
+                             : 0.0;
+      const double s0 = s, s1 = s + length;
+      s = s1 + gap;
+      const Eigen::Vector2d a =
+          road.Centre(s0) + side * front * road.LeftNormal(s0);
+      const Eigen::Vector2d b =
+          road.Centre(s1) + side * front * road.LeftNormal(s1);
+      Building building;
+      building.s0 = s0;
+      building.s1 = s1;
+      VerticalBox& box = building.box;
+      box.axis_u = (b - a).normalized();
+      box.half_u = 0.5 * (b - a).norm();
+      box.half_v = 0.5 * depth;
+      box.centre = 0.5 * (a + b) + side * 0.5 * depth * box.axis_v();
+      const double ground = std::min(
+          {road.Height(s0, side * front), road.Height(s1, side * front),
+           road.Height(0.5 * (s0 + s1), side * front)});
+      box.z0 = ground - 0.5;
+      box.z1 = ground + height;
+      building.front_side = side > 0 ? -1 : 1;
+      building.wall_tone = static_cast<float>(Uniform(&rng, 110.0, 185.0));
+      building.window_tone = static_cast<float>(Uniform(&rng, 30.0, 60.0));
+      building.window_period_m =
+          options.window_period_m * Uniform(&rng, 0.9, 1.1);
+      building.window_width_m =
+          building.window_period_m * Uniform(&rng, 0.38, 0.55);
+      building.window_height_m = Uniform(&rng, 1.3, 1.7);
+      building.sill_height_m = Uniform(&rng, 0.8, 1.0);
+      building.floor_height_m = Uniform(&rng, 2.9, 3.3);
+      building.ground_floor_height_m = Uniform(&rng, 3.6, 4.5);
+      const double face = 2.0 * box.half_u;
+      building.window_offset_m =
+          0.5 * (std::fmod(face, building.window_period_m) +
+                 building.window_period_m - building.window_width_m);
+      building.shop_front = Bernoulli(&rng, 0.5);
+      building.salt = rng();
+      world->buildings.push_back(building);
+    }
+  }
+}
+
+bool VehicleFits(const World& world, double s0, double s1, double side) {
+  if (NearCrossing(world, s0, s1, 0.5)) return false;
+  for (const ParkedVehicle& v : world.vehicles) {
+    const double v_side =
+        (v.box.centre - world.road.Centre(0.5 * (v.s0 + v.s1)))
+            .dot(world.road.LeftNormal(0.5 * (v.s0 + v.s1)));
+    if ((v_side > 0) == (side > 0) && s1 > v.s0 - 0.8 && s0 < v.s1 + 0.8) {
+      return false;
+    }
+  }
+  return true;
+}
+
+ParkedVehicle MakeVehicle(const Road& road, double s, double side,
+                          double length, std::mt19937_64* rng) {
+  ParkedVehicle v;
+  const double l = side * (0.5 * road.width_m() + 0.1);
+  v.box.centre = road.Centre(s) + l * road.LeftNormal(s);
+  v.box.axis_u = road.Tangent(s);
+  v.box.half_u = 0.5 * length;
+  v.box.half_v = 0.5 * Uniform(rng, 1.7, 1.9);
+  v.box.z0 = road.Height(s, l) - 0.05;
+  v.box.z1 = v.box.z0 + Uniform(rng, 1.4, 1.75);
+  v.body_tone = static_cast<float>(Uniform(rng, 25.0, 225.0));
+  v.s0 = s - 0.5 * length;
+  v.s1 = s + 0.5 * length;
+  v.salt = (*rng)();
+  return v;
+}
+
+void ParkVehicles(const SimulationOptions& options, World* world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kVehicleSeed));
+  const Road& road = world->road;
+  // Vehicles hiding the outer bands of a crossing from the approach.
+  for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
+    Crossing& c = world->crossings[ci];
+    const bool want = Bernoulli(&rng, options.occluding_vehicle_probability);
+    const double length = Uniform(&rng, 4.0, 4.8);
+    const double gap = Uniform(&rng, 0.6, 1.5);
+    if (!want || !c.in_street) continue;
+    const double s = c.s_min - gap - 0.5 * length;
+    if (!VehicleFits(*world, s - 0.5 * length, s + 0.5 * length, -1.0)) {
+      continue;
+    }
+    ParkedVehicle v = MakeVehicle(road, s, -1.0, length, &rng);
+    v.occludes_crossing = true;
+    c.occluded_by_vehicle = true;
+    world->vehicles.push_back(v);
+  }
+  const int count = PoissonCount(
+      &rng, options.parked_vehicles_per_100m * world->road.length_m() / 100.0);
+  for (int i = 0; i < count; ++i) {
+    for (int attempt = 0; attempt < 20; ++attempt) {
+      const double length = Uniform(&rng, 4.0, 4.8);
+      const double s = Uniform(&rng, 3.0, road.length_m() - 3.0);
+      const double side = Bernoulli(&rng, 0.5) ? 1.0 : -1.0;
+      if (!VehicleFits(*world, s - 0.5 * length, s + 0.5 * length, side)) {
+        continue;
+      }
+      world->vehicles.push_back(MakeVehicle(road, s, side, length, &rng));
+      break;
+    }
+  }
+}
+
+void CastShadows(const SimulationOptions& options, World* world) {
+  if (!options.shadows || world->sun_enu.z() < 0.05) return;
+  const Road& road = world->road;
+  for (const Building& b : world->buildings) {
+    world->shadows.push_back(
+        CastShadow(b.box, b.box.z0 + 0.5, world->sun_enu, 0.45f));
+  }
+  for (const ParkedVehicle& v : world->vehicles) {
+    double s = 0.0, l = 0.0;
+    road.ToRoadCoordinates(v.box.centre, 0.5 * (v.s0 + v.s1), &s, &l);
+    world->shadows.push_back(
+        CastShadow(v.box, road.Height(s, l), world->sun_enu, 0.5f));
+    // Contact shadow under the body.
+    VerticalBox under = v.box;
+    under.half_u += 0.15;
+    under.half_v += 0.15;
+    under.z1 = under.z0;
+    Shadow contact;
+    for (const Eigen::Vector2d& p : under.Footprint()) {
+      contact.polygon.push_back(p);
+    }
+    contact.factor = 0.55f;
+    world->shadows.push_back(contact);
+  }
+}
+
+}  // namespace
+
+void Shadow::Finish() {
+  edge_normals.clear();
+  edge_offsets.clear();
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector2d e = polygon[(i + 1) % polygon.size()] - polygon[i];
+    if (e.norm() < 1e-9) continue;
+    const Eigen::Vector2d normal = Eigen::Vector2d(-e.y(), e.x()).normalized();
+    edge_normals.push_back(normal);
+    edge_offsets.push_back(normal.dot(polygon[i]));
+  }
+}
+
+double Shadow::InsideDistance(const Eigen::Vector2d& p) const {
+  double d = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < edge_normals.size(); ++i) {
+    d = std::min(d, edge_normals[i].dot(p) - edge_offsets[i]);
+  }
+  return d;
+}
+
+std::array<Eigen::Vector2d, 4> VerticalBox::Footprint() const {
+  const Eigen::Vector2d u = half_u * axis_u;
+  const Eigen::Vector2d v = half_v * axis_v();
+  return {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
+}
+
+std::array<Eigen::Vector3d, 4> DesignBandCorners(
+    const Road& road, const Crossing& crossing, int band,
+    const Eigen::Vector2d& origin_xy) {
+  const double o0 =
+      crossing.first_offset_m + (band - 1) * crossing.band_period_m;
+  const double o1 = o0 + crossing.band_width_m;
+  const double half = 0.5 * crossing.band_length_m;
+  // Counter-clockwise from above: along t, then left (+n), then back.
+  const double ao[4][2] = {{-half, o0}, {half, o0}, {half, o1}, {-half, o1}};
+  std::array<Eigen::Vector3d, 4> ring;
+  const int start =
+      crossing.ring_start.empty() ? 0 : crossing.ring_start[band - 1];
+  for (int k = 0; k < 4; ++k) {
+    const double a = ao[(k + start) % 4][0];
+    const double o = ao[(k + start) % 4][1];
+    const double along = o * crossing.tan_skew + a;
+    const Eigen::Vector2d xy = origin_xy + o * crossing.n + along * crossing.t;
+    const double z = road.SurfaceHeightAt(xy, crossing.s_m + along);
+    ring[k] = Eigen::Vector3d(xy.x(), xy.y(), z);
+  }
+  return ring;
+}
+
+World BuildWorld(const SimulationOptions& options) {
+  RoadSpec spec;
+  spec.length_m = options.road_length_m + kLeadInM + kLookAheadM;
+  spec.width_m = options.road_width_m;
+  spec.crossfall = options.crossfall;
+  spec.crown_rounding_m = options.crown_rounding_m;
+  spec.max_grade = options.max_grade;
+  spec.grade_wavelength_m = options.grade_wavelength_m;
+  spec.curved_share = options.curved_share;
+  spec.min_curve_radius_m = options.min_curve_radius_m;
+  spec.max_curve_radius_m = options.max_curve_radius_m;
+  spec.transition_length_m = options.transition_length_m;
+  spec.start_heading_rad = 0.5 * kPi - options.start_heading_deg * kDegToRad;
+  World world;
+  world.road = Road::Generate(spec, SubSeed(options.seed, kRoadSeed));
+  world.s_drive_start = kLeadInM;
+  world.s_drive_end = kLeadInM + options.road_length_m;
+  world.lane_offset_m = -0.25 * options.road_width_m;
+  const double elevation = options.sun_elevation_deg * kDegToRad;
+  const double azimuth = options.sun_azimuth_deg * kDegToRad;
+  world.sun_enu = Eigen::Vector3d(std::sin(azimuth) * std::cos(elevation),
+                                  std::cos(azimuth) * std::cos(elevation),
+                                  std::sin(elevation));
+  world.paint_wear = static_cast<float>(options.paint_wear);
+  world.texture_salt = SubSeed(options.seed, kTextureSeed);
+  PlaceCrossings(options, &world);
+  PaintBands(options, &world);
+  PaintLines(options, &world);
+  PlaceSmallMarks(options, &world);
+  BuildFacades(options, &world);
+  ParkVehicles(options, &world);
+  CastShadows(options, &world);
+  for (Shadow& shadow : world.shadows) shadow.Finish();
+  return world;
+}
+
+namespace {
+
+// Samples of a line at constant l over [s0, s1], every `step` metres.
+std::vector<Eigen::Vector3d> SampleLine(const Road& road, double l, double s0,
+                                        double s1, double step) {
+  std::vector<Eigen::Vector3d> points;
+  const int n = std::max(1, static_cast<int>(std::ceil((s1 - s0) / step)));
+  for (int i = 0; i <= n; ++i) {
+    points.push_back(road.SurfacePoint(s0 + (s1 - s0) * i / n, l));
+  }
+  return points;
+}
+
+struct LineGeometry {
+  std::string id;
+  std::string type;
+  std::vector<Eigen::Vector3d> points;
+};
+
+std::vector<LineGeometry> LineGeometries(const World& world) {
+  std::vector<LineGeometry> out;
+  int dash = 0, solid = 0;
+  for (const LinePiece& line : world.lines) {
+    const bool dashed = line.type == "lane_dashed";
+    out.push_back({dashed ? "dash-" + std::to_string(++dash)
+                          : "solid-" + std::to_string(++solid),
+                   line.type,
+                   SampleLine(world.road, line.l_m, line.s0, line.s1,
+                              dashed ? 1.0 : 2.0)});
+  }
+  for (const StopLine& stop : world.stop_lines) {
+    const Road& road = world.road;
+    out.push_back({"stop-" + world.crossings[stop.crossing].id,
+                   "stop_line",
+                   {road.SurfacePoint(stop.s_m, stop.l0),
+                    road.SurfacePoint(stop.s_m, stop.l1)}});
+  }
+  return out;
+}
+
+}  // namespace
+
+RoadmarkDatabase MakeTruthRoadmarks(const World& world,
+                                    const LocalFrame& frame) {
+  RoadmarkDatabase db;
+  for (const Band& band : world.bands) {
+    RoadmarkBand out;
+    out.crossing_id = world.crossings[band.crossing].id;
+    out.band = band.band;
+    for (int k = 0; k < 4; ++k) {
+      out.corners[k] = frame.GeodeticFromEnu(band.corners[k]);
+    }
+    db.bands.push_back(out);
+  }
+  for (const LineGeometry& line : LineGeometries(world)) {
+    RoadmarkLine out;
+    out.id = line.id;
+    out.type = line.type;
+    for (const Eigen::Vector3d& p : line.points) {
+      out.points.push_back(frame.GeodeticFromEnu(p));
+    }
+    db.lines.push_back(out);
+  }
+  return db;
+}
+
+RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
+                                       const SimulationOptions& options,
+                                       const LocalFrame& frame) {
+  std::mt19937_64 rng(SubSeed(options.seed, kDatabaseSeed));
+  const double sxy = options.database_sigma_xy_m;
+  const double sz = options.database_sigma_z_m;
+  auto noise = [&]() {
+    const double e = Gaussian(&rng, sxy);
+    const double n = Gaussian(&rng, sxy);
+    return Eigen::Vector3d(e, n, Gaussian(&rng, sz));
+  };
+  RoadmarkDatabase db;
+  for (const Crossing& c : world.crossings) {
+    if (!c.in_db) continue;
+    const Eigen::Vector2d origin = c.origin_xy - c.repaint_shift_xy;
+    for (int k = 1; k <= c.num_db_bands; ++k) {
+      const auto corners = DesignBandCorners(world.road, c, k, origin);
+      RoadmarkBand out;
+      out.crossing_id = c.id;
+      out.band = k;
+      out.sigma_xy_m = sxy;
+      out.sigma_z_m = sz;
+      for (int v = 0; v < 4; ++v) {
+        out.corners[v] =
+            frame.GeodeticFromEnu(corners[v] + c.db_offset_enu + noise());
+      }
+      db.bands.push_back(out);
+    }
+  }
+  for (const LineGeometry& line : LineGeometries(world)) {
+    RoadmarkLine out;
+    out.id = line.id;
+    out.type = line.type;
+    out.sigma_xy_m = sxy;
+    out.sigma_z_m = sz;
+    for (const Eigen::Vector3d& p : line.points) {
+      out.points.push_back(frame.GeodeticFromEnu(p + noise()));
+    }
+    db.lines.push_back(out);
+  }
+  return db;
+}
+
+}  // namespace zebrageo::sim
