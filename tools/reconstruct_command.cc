@@ -1,19 +1,108 @@
-// `zebrageo reconstruct SURVEY -o RESULTS`.
-#include <memory>
+// `zebrageo reconstruct SURVEY -o RESULTS`: the zebra bands of every stereo
+// pair in 3D (body frame), written to RESULTS/reconstructed_bands.csv.
+#include <glog/logging.h>
 
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "reconstruction/reconstruction.h"
+#include "survey/results.h"
+#include "survey/survey.h"
 #include "tools/commands.h"
+#include "tools/exit_codes.h"
+#include "tools/progress.h"
 
 namespace zebrageo {
+namespace {
+
+struct ReconstructArguments {
+  StageArguments stage;
+  int threads = 0;
+  std::string debug_images;
+  double nominal_camera_height_m =
+      ReconstructionOptions().search.nominal_camera_height_m;
+  double ground_pixel_m = ReconstructionOptions().rectification.ground_pixel_m;
+  double min_long_side_length_m =
+      ReconstructionOptions().long_sides.min_long_side_length_m;
+};
+
+void RunReconstruct(const ReconstructArguments& args) {
+  SurveyLoadOptions load_options;
+  load_options.load_roadmarks = false;
+  const Survey survey = LoadSurvey(args.stage.survey, load_options);
+
+  ReconstructionOptions options;
+  options.threads = args.threads;
+  options.debug_image_folder = args.debug_images;
+  options.search.nominal_camera_height_m = args.nominal_camera_height_m;
+  options.rectification.ground_pixel_m = args.ground_pixel_m;
+  options.long_sides.min_long_side_length_m = args.min_long_side_length_m;
+  const std::string error = options.Check();
+  if (!error.empty()) throw UsageError(error);
+
+  std::filesystem::create_directories(args.stage.results);
+  std::vector<ReconstructedVertex> vertices;
+  ProgressBar bar("reconstruct");
+  const ReconstructionSummary summary =
+      ReconstructSurvey(survey, options, &vertices, bar.Callback());
+  bar.Finish();
+  if (!summary.IsUsable()) throw StageFailedError(summary.message);
+
+  std::vector<std::string> comments = {
+      "zebrageo reconstruct: " + summary.BriefReport(),
+      "per stereo pair: " + [&] {
+        StepTimings mean = summary.timings;
+        const double n = std::max(1, summary.pairs_processed);
+        mean.read_images_s /= n;
+        mean.rectify_s /= n;
+        mean.edges_s /= n;
+        mean.matching_s /= n;
+        mean.road_plane_s /= n;
+        mean.long_sides_s /= n;
+        mean.bands_s /= n;
+        mean.debug_images_s /= n;
+        return mean.Report();
+      }()};
+  for (const std::string& warning : summary.warnings) {
+    comments.push_back("warning: " + warning);
+  }
+  WriteReconstructedBands(
+      vertices, comments,
+      (std::filesystem::path(args.stage.results) / kReconstructedBandsFile)
+          .string());
+  LOG(INFO) << "reconstruct: " << summary.BriefReport() << " in "
+            << summary.wall_time_s << " s";
+  LOG(INFO) << "reconstruct: " << comments[1];
+}
+
+}  // namespace
 
 void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands) {
-  auto args = std::make_shared<StageArguments>();
+  auto args = std::make_shared<ReconstructArguments>();
   CLI::App* sub =
       AddStageSubcommand(app, "reconstruct",
                          "Reconstruct the zebra bands of every stereo pair in "
                          "3D; writes reconstructed_bands.csv.",
-                         args.get());
-  commands->push_back(
-      {sub, NotImplementedStage(args, "reconstruct", "issue 5")});
+                         &args->stage);
+  sub->add_option("--threads", args->threads,
+                  "worker threads (0: one per hardware thread)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--debug-images", args->debug_images,
+                  "write images with edges, candidates and bands to DIR");
+  sub->add_option("--camera-height", args->nominal_camera_height_m,
+                  "nominal height of the cameras over the road, metres (a "
+                  "starting point: the road plane is estimated)")
+      ->capture_default_str();
+  sub->add_option("--ground-pixel", args->ground_pixel_m,
+                  "ground sample distance of the rectified road images, m")
+      ->capture_default_str();
+  sub->add_option("--min-side-length", args->min_long_side_length_m,
+                  "L_min: shortest long side of a band kept, metres")
+      ->capture_default_str();
+  commands->push_back({sub, [args] { RunReconstruct(*args); }});
 }
 
 }  // namespace zebrageo

@@ -1,0 +1,981 @@
+#include "reconstruction/band_modeling.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "reconstruction/road_plane.h"
+
+namespace zebrageo {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+using Area = std::array<Eigen::Vector2d, 4>;
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+bool InsideConvex(const Area& area, const Eigen::Vector2d& p) {
+  int sign = 0;
+  for (int k = 0; k < 4; ++k) {
+    const double c = Cross(area[(k + 1) % 4] - area[k], p - area[k]);
+    const int s = c > 0.0 ? 1 : (c < 0.0 ? -1 : 0);
+    if (s == 0) continue;
+    if (sign == 0) sign = s;
+    if (s != sign) return false;
+  }
+  return true;
+}
+
+// Pixels inside the area.
+std::vector<Eigen::Vector2i> PixelsInArea(const EdgeMap& edges,
+                                          const Area& area) {
+  double y_min = 1e30, y_max = -1e30, x_min = 1e30, x_max = -1e30;
+  for (const Eigen::Vector2d& c : area) {
+    y_min = std::min(y_min, c.y());
+    y_max = std::max(y_max, c.y());
+    x_min = std::min(x_min, c.x());
+    x_max = std::max(x_max, c.x());
+  }
+  std::vector<Eigen::Vector2i> inside;
+  const int y0 = std::max(0, static_cast<int>(std::ceil(y_min)));
+  const int y1 = std::min(edges.height - 1, static_cast<int>(y_max));
+  const int x0 = std::max(0, static_cast<int>(std::ceil(x_min)));
+  const int x1 = std::min(edges.width - 1, static_cast<int>(x_max));
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      if (InsideConvex(area, Eigen::Vector2d(x, y)) &&
+          (edges.usable.empty() || edges.usable.at<uint8_t>(y, x))) {
+        inside.emplace_back(x, y);
+      }
+    }
+  }
+  return inside;
+}
+
+// Sum of the image gradient along the line, inside the area (1 px steps).
+Eigen::Vector2d Gamma(const EdgeMap& edges, const Area& area,
+                      const ImageLine& line) {
+  const Eigen::Vector2d direction(-line.normal.y(), line.normal.x());
+  const Eigen::Vector2d origin = line.rho * line.normal;
+  double reach = 0.0;
+  for (const Eigen::Vector2d& c : area) {
+    reach = std::max(reach, std::abs((c - origin).dot(direction)));
+  }
+  Eigen::Vector2d gamma = Eigen::Vector2d::Zero();
+  for (double t = -reach; t <= reach; t += 1.0) {
+    const Eigen::Vector2d p = origin + t * direction;
+    if (!InsideConvex(area, p) || !edges.IsUsable(p.x(), p.y())) continue;
+    const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
+    gamma += Eigen::Vector2d(g[0], g[1]);
+  }
+  return gamma;
+}
+
+// Image line through two points.
+ImageLine LineThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  ImageLine line;
+  const Eigen::Vector2d d = (b - a).normalized();
+  line.normal = Eigen::Vector2d(-d.y(), d.x());
+  line.rho = line.normal.dot(a);
+  return line;
+}
+
+bool Intersect(const ImageLine& a, const ImageLine& b, Eigen::Vector2d* x) {
+  Eigen::Matrix2d A;
+  A << a.normal.x(), a.normal.y(), b.normal.x(), b.normal.y();
+  const double det = A.determinant();
+  if (std::abs(det) < 1e-9) return false;
+  *x = A.inverse() * Eigen::Vector2d(a.rho, b.rho);
+  return true;
+}
+
+// A 2D line of the plane frame: point + t * direction.
+struct PlaneLine {
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();
+};
+
+// TLS line through 2D points; when they are fewer than 2 or spread less
+// than 0.3 m, the line through their mean along `fallback`.
+PlaneLine FitPlaneLine(const std::vector<Eigen::Vector2d>& points,
+                       const Eigen::Vector2d& fallback) {
+  PlaneLine line;
+  line.direction = fallback;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  line.point = mean;
+  if (points.size() < 2) return line;
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  double spread = 0.0;
+  for (const Eigen::Vector2d& p : points) {
+    scatter += (p - mean) * (p - mean).transpose();
+    spread = std::max(spread, (p - mean).norm());
+  }
+  if (spread < 0.15) return line;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
+  line.direction = solver.eigenvectors().col(1);
+  if (line.direction.dot(fallback) < 0.0) line.direction = -line.direction;
+  return line;
+}
+
+// Robust line through the band extremities of a crossing: the line through
+// two of them (at least 0.3 m apart, within 40 degrees of `fallback`, the
+// perpendicular to the bands) with the most points within 0.1 m, refitted
+// on those. A band cut short by an occlusion or a wrongly paired side is an
+// outlier. One point, or none qualifying: the line through the median
+// point along `fallback`.
+PlaneLine FitRobustPlaneLine(const std::vector<Eigen::Vector2d>& points,
+                             const Eigen::Vector2d& fallback) {
+  constexpr double kInlierDistance = 0.1;
+  const double min_cos = std::cos(40.0 * kPi / 180.0);
+  const int n = static_cast<int>(points.size());
+  int best_count = 0;
+  double best_residual = 1e30;
+  PlaneLine best;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      const Eigen::Vector2d d = points[j] - points[i];
+      if (d.norm() < 0.3) continue;
+      const Eigen::Vector2d direction = d.normalized();
+      if (std::abs(direction.dot(fallback)) < min_cos) continue;
+      const Eigen::Vector2d normal(-direction.y(), direction.x());
+      int count = 0;
+      double residual = 0.0;
+      for (const Eigen::Vector2d& p : points) {
+        const double r = std::abs((p - points[i]).dot(normal));
+        if (r <= kInlierDistance) {
+          ++count;
+          residual += r;
+        }
+      }
+      if (count > best_count ||
+          (count == best_count && residual < best_residual)) {
+        best_count = count;
+        best_residual = residual;
+        best.point = points[i];
+        best.direction = direction.dot(fallback) < 0.0 ? -direction : direction;
+      }
+    }
+  }
+  if (best_count < 2) {
+    // The median point along the perpendicular.
+    std::vector<Eigen::Vector2d> sorted = points;
+    const Eigen::Vector2d along(fallback.y(), -fallback.x());
+    std::sort(sorted.begin(), sorted.end(),
+              [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+                return a.dot(along) < b.dot(along);
+              });
+    PlaneLine line;
+    line.direction = fallback;
+    line.point =
+        sorted.empty() ? Eigen::Vector2d::Zero() : sorted[sorted.size() / 2];
+    return line;
+  }
+  std::vector<Eigen::Vector2d> inliers;
+  const Eigen::Vector2d normal(-best.direction.y(), best.direction.x());
+  for (const Eigen::Vector2d& p : points) {
+    if (std::abs((p - best.point).dot(normal)) <= kInlierDistance) {
+      inliers.push_back(p);
+    }
+  }
+  return FitPlaneLine(inliers, best.direction);
+}
+
+// Point of `line` at lateral coordinate `lateral` (x . normal), shifted by
+// `shift` along the band direction.
+Eigen::Vector2d AtLateral(const PlaneLine& line, const Eigen::Vector2d& along,
+                          const Eigen::Vector2d& normal, double lateral,
+                          double shift) {
+  const Eigen::Vector2d origin = line.point + shift * along;
+  const double denominator = line.direction.dot(normal);
+  const double t = std::abs(denominator) > 1e-9
+                       ? (lateral - origin.dot(normal)) / denominator
+                       : 0.0;
+  return origin + t * line.direction;
+}
+
+// Lifts a plane-frame point vertically (along the frame normal) onto the
+// band plane.
+Eigen::Vector3d OnBandPlane(const PlaneFrame& frame, const RoadPlane& plane,
+                            const Eigen::Vector2d& q) {
+  const Eigen::Vector3d p = frame.To3d(q);
+  const double denominator = plane.normal_body.dot(frame.normal);
+  return p - plane.SignedDistance(p) / denominator * frame.normal;
+}
+
+// Least-squares plane of a band and the variance of its height at a point:
+// z = a x + b y + c in the band's own frame (x along, y across, z normal).
+struct BandPlaneFit {
+  RoadPlane plane;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x_axis, y_axis;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of (a, b, c)
+  double rms_m = 0.0;
+  int count = 0;
+
+  double HeightVariance(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d d = p - centroid;
+    const Eigen::Vector3d j(d.dot(x_axis), d.dot(y_axis), 1.0);
+    return j.dot(covariance * j);
+  }
+};
+
+bool FitBandPlane(const std::vector<Eigen::Vector3d>& points,
+                  const Eigen::Vector3d& along, const Eigen::Vector3d& normal,
+                  double min_sigma_m, BandPlaneFit* fit) {
+  if (!FitPlaneLeastSquares(points, normal, &fit->plane)) return false;
+  const Eigen::Vector3d n = fit->plane.normal_body;
+  fit->x_axis = (along - along.dot(n) * n).normalized();
+  fit->y_axis = n.cross(fit->x_axis);
+  fit->centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) fit->centroid += p;
+  fit->centroid /= static_cast<double>(points.size());
+  Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();
+  double sum_squares = 0.0;
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d d = p - fit->centroid;
+    const Eigen::Vector3d j(d.dot(fit->x_axis), d.dot(fit->y_axis), 1.0);
+    normal_matrix += j * j.transpose();
+    sum_squares += fit->plane.SignedDistance(p) * fit->plane.SignedDistance(p);
+  }
+  fit->count = static_cast<int>(points.size());
+  fit->rms_m = std::sqrt(sum_squares / std::max(1, fit->count - 3));
+  const double sigma = std::max(fit->rms_m, min_sigma_m);
+  fit->covariance = sigma * sigma * normal_matrix.inverse();
+  return true;
+}
+
+struct BandCandidate {
+  int lo = -1;  // side with the smaller lateral coordinate
+  int hi = -1;
+  double cost = 0.0;
+  // Extent of the band (the overlap of its sides) along the direction of
+  // its set: a side may run on along a lane line, the overlap does not.
+  double begin = 0.0;
+  double end = 0.0;
+};
+
+// Union-find root.
+int Root(std::vector<int>* parent, int i) {
+  while ((*parent)[i] != i) i = (*parent)[i] = (*parent)[(*parent)[i]];
+  return i;
+}
+
+// Extent of a side along a 2D direction of the plane frame.
+void Extent(const PlaneFrame& frame, const LongSide& side,
+            const Eigen::Vector2d& along, double* low, double* high) {
+  const double a = frame.To2d(side.Begin()).dot(along);
+  const double b = frame.To2d(side.End()).dot(along);
+  *low = std::min(a, b);
+  *high = std::max(a, b);
+}
+
+}  // namespace
+
+std::string BandOptions::Check() const {
+  std::ostringstream error;
+  if (!(max_side_angle_rad > 0.0 && max_side_angle_rad < 0.5)) {
+    error << "max_side_angle_rad = " << max_side_angle_rad
+          << ": must be in (0, 0.5)";
+  } else if (!(min_side_overlap_fraction >= 0.0 &&
+               min_side_overlap_fraction <= 1.0)) {
+    error << "min_side_overlap_fraction = " << min_side_overlap_fraction
+          << ": must be in [0, 1]";
+  } else if (!(extremity_length_fraction > 0.0 &&
+               extremity_length_fraction <= 1.0)) {
+    error << "extremity_length_fraction = " << extremity_length_fraction
+          << ": must be in (0, 1]";
+  } else if (!(transversal_search_m > 0.0)) {
+    error << "transversal_search_m = " << transversal_search_m
+          << ": must be > 0";
+  } else if (!(side_margin_m >= 0.0)) {
+    error << "side_margin_m = " << side_margin_m << ": must be >= 0";
+  } else if (!(transversal_max_angle_rad > 0.0 &&
+               transversal_max_angle_rad < 1.5)) {
+    error << "transversal_max_angle_rad = " << transversal_max_angle_rad
+          << ": must be in (0, 1.5)";
+  } else if (!(point_angle_tolerance_rad > 0.0)) {
+    error << "point_angle_tolerance_rad = " << point_angle_tolerance_rad
+          << ": must be > 0";
+  } else if (!(hough_angle_step_rad > 0.0 && hough_angle_step_rad < 0.2)) {
+    error << "hough_angle_step_rad = " << hough_angle_step_rad
+          << ": must be in (0, 0.2)";
+  } else if (!(hough_rho_step_px > 0.0)) {
+    error << "hough_rho_step_px = " << hough_rho_step_px << ": must be > 0";
+  } else if (!(hough_score_fraction > 0.0 && hough_score_fraction <= 1.0)) {
+    error << "hough_score_fraction = " << hough_score_fraction
+          << ": must be in (0, 1]";
+  } else if (!(pair_score_fraction > 0.0 && pair_score_fraction <= 1.0)) {
+    error << "pair_score_fraction = " << pair_score_fraction
+          << ": must be in (0, 1]";
+  } else if (!(hough_min_gradient > 0.0)) {
+    error << "hough_min_gradient = " << hough_min_gradient << ": must be > 0";
+  } else if (!(refine_distance_px > 0.0)) {
+    error << "refine_distance_px = " << refine_distance_px << ": must be > 0";
+  } else if (min_transversal_points < 2) {
+    error << "min_transversal_points = " << min_transversal_points
+          << ": must be >= 2";
+  } else if (!(max_stereo_disagreement_m > 0.0)) {
+    error << "max_stereo_disagreement_m = " << max_stereo_disagreement_m
+          << ": must be > 0";
+  } else if (!(max_crossing_gap_m > 0.0)) {
+    error << "max_crossing_gap_m = " << max_crossing_gap_m << ": must be > 0";
+  } else if (!(max_band_range_m > 0.0)) {
+    error << "max_band_range_m = " << max_band_range_m << ": must be > 0";
+  } else if (!(min_line_sigma_px > 0.0)) {
+    error << "min_line_sigma_px = " << min_line_sigma_px << ": must be > 0";
+  } else if (!(min_sigma_m > 0.0)) {
+    error << "min_sigma_m = " << min_sigma_m << ": must be > 0";
+  }
+  return error.str();
+}
+
+std::vector<ImageLine> HoughTransversalCandidates(
+    const EdgeMap& edges, const Area& area,
+    const Eigen::Vector2d& expected_normal, const BandOptions& options) {
+  std::vector<ImageLine> lines;
+  const std::vector<Eigen::Vector2i> inside = PixelsInArea(edges, area);
+  const double theta0 = std::atan2(expected_normal.y(), expected_normal.x());
+  const int half = static_cast<int>(std::ceil(
+      options.transversal_max_angle_rad / options.hough_angle_step_rad));
+  const int n_theta = 2 * half + 1;
+  std::vector<double> cos_t(n_theta), sin_t(n_theta);
+  double rho_min = 1e30, rho_max = -1e30;
+  for (int k = 0; k < n_theta; ++k) {
+    const double theta = theta0 + (k - half) * options.hough_angle_step_rad;
+    cos_t[k] = std::cos(theta);
+    sin_t[k] = std::sin(theta);
+    for (const Eigen::Vector2d& c : area) {
+      const double rho = c.x() * cos_t[k] + c.y() * sin_t[k];
+      rho_min = std::min(rho_min, rho);
+      rho_max = std::max(rho_max, rho);
+    }
+  }
+  const double step = options.hough_rho_step_px;
+  const int n_rho = static_cast<int>((rho_max - rho_min) / step) + 2;
+  std::vector<float> votes(static_cast<size_t>(n_theta) * n_rho, 0.0f);
+  // Every pixel with a gradient votes, weighted by its norm: transversal
+  // sides far away are blurred along the road over several pixels, where
+  // non-maximum suppression finds no reliable edge points.
+  for (const Eigen::Vector2i& pixel : inside) {
+    const float gx = edges.gx.at<float>(pixel.y(), pixel.x());
+    const float gy = edges.gy.at<float>(pixel.y(), pixel.x());
+    const float norm = std::hypot(gx, gy);
+    if (norm < options.hough_min_gradient) continue;
+    const double phi = std::atan2(gy, gx);
+    for (int k = 0; k < n_theta; ++k) {
+      const double theta = theta0 + (k - half) * options.hough_angle_step_rad;
+      // Oriented: only the expected polarity votes (a shadow edge across
+      // the band, darkening into it, must not outvote the paint's end).
+      if (std::abs(std::remainder(phi - theta, 2.0 * kPi)) >
+          options.point_angle_tolerance_rad) {
+        continue;
+      }
+      const double rho = pixel.x() * cos_t[k] + pixel.y() * sin_t[k];
+      const int r = static_cast<int>(std::lround((rho - rho_min) / step));
+      if (r >= 0 && r < n_rho) {
+        votes[static_cast<size_t>(k) * n_rho + r] += norm;
+      }
+    }
+  }
+  if (votes.empty()) return lines;
+  const float best = *std::max_element(votes.begin(), votes.end());
+  if (best < options.min_transversal_points * options.hough_min_gradient) {
+    return lines;
+  }
+  for (int k = 0; k < n_theta; ++k) {
+    for (int r = 0; r < n_rho; ++r) {
+      const float v = votes[static_cast<size_t>(k) * n_rho + r];
+      if (v < options.hough_score_fraction * best) continue;
+      bool is_max = true;
+      for (int dk = -1; dk <= 1 && is_max; ++dk) {
+        for (int dr = -1; dr <= 1; ++dr) {
+          if (dk == 0 && dr == 0) continue;
+          const int kk = k + dk, rr = r + dr;
+          if (kk < 0 || rr < 0 || kk >= n_theta || rr >= n_rho) continue;
+          const float w = votes[static_cast<size_t>(kk) * n_rho + rr];
+          // Plateaus: the first cell in scan order is the maximum.
+          if (w > v || (w == v && (dk < 0 || (dk == 0 && dr < 0)))) {
+            is_max = false;
+            break;
+          }
+        }
+      }
+      if (!is_max) continue;
+      ImageLine line;
+      line.normal = Eigen::Vector2d(cos_t[k], sin_t[k]);
+      line.rho = rho_min + r * step;
+      line.votes = v;
+      line.gamma = Gamma(edges, area, line);
+      lines.push_back(line);
+    }
+  }
+  std::stable_sort(
+      lines.begin(), lines.end(),
+      [](const ImageLine& a, const ImageLine& b) { return a.votes > b.votes; });
+  if (lines.size() > 10) lines.resize(10);
+  return lines;
+}
+
+bool ChooseTransversalPair(const std::vector<ImageLine>& begin,
+                           const std::vector<ImageLine>& end,
+                           const Eigen::Vector2d& band_direction,
+                           const BandOptions& options, int* t, int* l) {
+  double best_score = 0.0;
+  for (const ImageLine& a : begin) {
+    if (a.gamma.dot(band_direction) <= 0.0) continue;
+    for (const ImageLine& b : end) {
+      if (b.gamma.dot(band_direction) >= 0.0) continue;
+      best_score = std::max(best_score, a.gamma.norm() + b.gamma.norm());
+    }
+  }
+  if (!(best_score > 0.0)) return false;
+  double best_dot = 1e300;
+  *t = *l = -1;
+  for (size_t i = 0; i < begin.size(); ++i) {
+    if (begin[i].gamma.dot(band_direction) <= 0.0) continue;
+    for (size_t j = 0; j < end.size(); ++j) {
+      if (end[j].gamma.dot(band_direction) >= 0.0) continue;
+      const double score = begin[i].gamma.norm() + end[j].gamma.norm();
+      if (score < options.pair_score_fraction * best_score) continue;
+      const double dot = begin[i].gamma.dot(end[j].gamma);
+      if (dot < best_dot) {
+        best_dot = dot;
+        *t = static_cast<int>(i);
+        *l = static_cast<int>(j);
+      }
+    }
+  }
+  return *t >= 0;
+}
+
+bool RefineImageLine(const EdgeMap& edges, const Area& area,
+                     const BandOptions& options, ImageLine* line) {
+  // Sub-pixel edge positions along the line: at every pixel step along it,
+  // the centroid of the gradient profile across it (the gradient projected
+  // on the line's polarity, over the contiguous part above a third of its
+  // peak). For a blurred step the profile is symmetric about the edge, so
+  // the centroid is unbiased whatever the blur; the points are then fitted
+  // by weighted least squares, twice, dropping outliers.
+  if (!(line->gamma.norm() > 0.0)) return false;
+  const Eigen::Vector2d polarity = line->gamma.normalized();
+  const double reach = options.refine_distance_px;
+  const double step = 0.5;
+  const int half = static_cast<int>(std::ceil(reach / step));
+  ImageLine current = *line;
+  std::vector<double> profile(2 * half + 1);
+  for (int round = 0; round < 3; ++round) {
+    const Eigen::Vector2d direction(-current.normal.y(), current.normal.x());
+    const Eigen::Vector2d origin = current.rho * current.normal;
+    double t_min = 1e30, t_max = -1e30;
+    for (const Eigen::Vector2d& c : area) {
+      t_min = std::min(t_min, (c - origin).dot(direction));
+      t_max = std::max(t_max, (c - origin).dot(direction));
+    }
+    std::vector<Eigen::Vector2d> points;
+    std::vector<double> weights;
+    for (double t = std::ceil(t_min); t <= t_max; t += 1.0) {
+      const Eigen::Vector2d base = origin + t * direction;
+      if (!InsideConvex(area, base)) continue;
+      int peak = -1;
+      bool usable = true;
+      for (int k = -half; k <= half && usable; ++k) {
+        const Eigen::Vector2d p = base + k * step * current.normal;
+        usable = edges.IsUsable(p.x(), p.y());
+        const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
+        profile[k + half] =
+            std::max(0.0, polarity.x() * g[0] + polarity.y() * g[1]);
+        if (peak < 0 || profile[k + half] > profile[peak]) peak = k + half;
+      }
+      if (!usable) continue;
+      const double top = profile[peak];
+      if (!(top >= options.hough_min_gradient)) continue;
+      if (peak == 0 || peak == 2 * half) continue;  // edge outside the window
+      int lo = peak, hi = peak;
+      while (lo > 0 && profile[lo - 1] > top / 3.0) --lo;
+      while (hi < 2 * half && profile[hi + 1] > top / 3.0) ++hi;
+      double sum = 0.0, moment = 0.0;
+      for (int k = lo; k <= hi; ++k) {
+        const double w = profile[k] - top / 3.0;
+        sum += w;
+        moment += w * (k - half) * step;
+      }
+      points.push_back(base + (moment / sum) * current.normal);
+      weights.push_back(top);
+    }
+    // Weighted least squares, then without points more than 3 rms (at
+    // least 0.5 px) away.
+    std::vector<char> keep(points.size(), 1);
+    for (int pass = 0; pass < 2; ++pass) {
+      double w_sum = 0.0;
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      int count = 0;
+      for (size_t k = 0; k < points.size(); ++k) {
+        if (!keep[k]) continue;
+        w_sum += weights[k];
+        mean += weights[k] * points[k];
+        ++count;
+      }
+      if (count < options.min_transversal_points) return false;
+      mean /= w_sum;
+      Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+      for (size_t k = 0; k < points.size(); ++k) {
+        if (!keep[k]) continue;
+        const Eigen::Vector2d d = points[k] - mean;
+        scatter += weights[k] * d * d.transpose();
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
+      Eigen::Vector2d normal = solver.eigenvectors().col(0);
+      if (normal.dot(current.normal) < 0.0) normal = -normal;
+      current.normal = normal;
+      current.rho = normal.dot(mean);
+      double sum_squares = 0.0;
+      for (size_t k = 0; k < points.size(); ++k) {
+        if (!keep[k]) continue;
+        const double r = current.Distance(points[k]);
+        sum_squares += r * r;
+      }
+      current.support = count;
+      current.rms_px = std::sqrt(sum_squares / count);
+      const double limit = std::max(0.5, 3.0 * current.rms_px);
+      for (size_t k = 0; k < points.size(); ++k) {
+        keep[k] = std::abs(current.Distance(points[k])) <= limit;
+      }
+    }
+  }
+  current.gamma = Gamma(edges, area, current);
+  *line = current;
+  return true;
+}
+
+std::vector<Band> ModelBands(const LongSideDetection& detection,
+                             const PlaneFrame& frame,
+                             const RoadRectification& rectification,
+                             const EdgeMap edges[2],
+                             const ZebraSpecification& zebra,
+                             const BandOptions& options,
+                             BandModelingDebug* debug) {
+  const std::vector<LongSide>& sides = detection.sides;
+  const int n = static_cast<int>(sides.size());
+
+  // 1. Pairs of long sides: parallel, one band width apart, overlapping,
+  // with inverse gradients and the bright paint between them.
+  std::vector<BandCandidate> candidates;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const LongSide& a = sides[i];
+      const LongSide& b = sides[j];
+      if (i == j || a.direction_set != b.direction_set) continue;
+      if (!(a.lateral_m < b.lateral_m)) continue;
+      if (std::acos(
+              std::min(1.0, std::abs(a.direction_body.dot(b.direction_body)))) >
+          options.max_side_angle_rad) {
+        continue;
+      }
+      const double width = b.lateral_m - a.lateral_m;
+      if (std::abs(width - zebra.band_width_m) > zebra.band_width_tolerance_m) {
+        continue;
+      }
+      if (!(a.contrast > 0.0 && b.contrast < 0.0)) continue;
+      double a0, a1, b0, b1;
+      Extent(frame, a, a.direction_2d, &a0, &a1);
+      Extent(frame, b, a.direction_2d, &b0, &b1);
+      const double overlap = std::min(a1, b1) - std::max(a0, b0);
+      if (overlap <
+          options.min_side_overlap_fraction * std::min(a1 - a0, b1 - b0)) {
+        continue;
+      }
+      // Nothing between the two sides: the paint is one band (a side paired
+      // with the far edge of a lane line next to the band is not).
+      bool between = false;
+      for (int k = 0; k < n && !between; ++k) {
+        const LongSide& s = sides[k];
+        if (k == i || k == j || s.direction_set != a.direction_set) continue;
+        if (s.lateral_m <= a.lateral_m + 0.05 ||
+            s.lateral_m >= b.lateral_m - 0.05) {
+          continue;
+        }
+        double s0, s1;
+        Extent(frame, s, a.direction_2d, &s0, &s1);
+        between =
+            std::min(s1, std::min(a1, b1)) - std::max(s0, std::max(a0, b0)) >
+            0.0;
+      }
+      if (between) continue;
+      BandCandidate c;
+      c.lo = i;
+      c.hi = j;
+      c.begin = std::max(a0, b0);
+      c.end = std::min(a1, b1);
+      c.cost =
+          std::abs(width - zebra.band_width_m) / zebra.band_width_tolerance_m -
+          overlap / zebra.min_band_length_m;
+      candidates.push_back(c);
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const BandCandidate& x, const BandCandidate& y) {
+                     return x.cost < y.cost;
+                   });
+  std::vector<char> side_used(n, 0);
+  std::vector<BandCandidate> pairs;
+  for (const BandCandidate& c : candidates) {
+    if (side_used[c.lo] || side_used[c.hi]) continue;
+    side_used[c.lo] = side_used[c.hi] = 1;
+    pairs.push_back(c);
+  }
+  if (debug != nullptr) {
+    for (const BandCandidate& c : pairs) {
+      for (int s : {c.lo, c.hi}) {
+        Eigen::Vector2d a, b;
+        if (rectification.ProjectToRectified(0, sides[s].Begin(), &a) &&
+            rectification.ProjectToRectified(0, sides[s].End(), &b)) {
+          debug->band_pairs.push_back({a, b});
+        }
+      }
+    }
+  }
+
+  // 2. Crossings: bands of one direction, side by side.
+  const int m = static_cast<int>(pairs.size());
+  std::vector<int> parent(m);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int i = 0; i < m; ++i) {
+    for (int j = i + 1; j < m; ++j) {
+      const LongSide& a_lo = sides[pairs[i].lo];
+      const LongSide& b_lo = sides[pairs[j].lo];
+      if (a_lo.direction_set != b_lo.direction_set) continue;
+      const double a_hi = sides[pairs[i].hi].lateral_m;
+      const double b_hi = sides[pairs[j].hi].lateral_m;
+      const double gap = std::max(b_lo.lateral_m - a_hi, a_lo.lateral_m - b_hi);
+      if (gap > options.max_crossing_gap_m) continue;
+      double a0, a1, b0, b1;
+      Extent(frame, a_lo, a_lo.direction_2d, &a0, &a1);
+      Extent(frame, b_lo, a_lo.direction_2d, &b0, &b1);
+      if (std::min(a1, b1) - std::max(a0, b0) <= 0.0) continue;
+      parent[Root(&parent, i)] = Root(&parent, j);
+    }
+  }
+  std::vector<int> crossing_of(m);
+  {
+    std::vector<int> label(m, -1);
+    int next_label = 0;
+    for (int i = 0; i < m; ++i) {
+      const int root = Root(&parent, i);
+      if (label[root] < 0) label[root] = next_label++;
+      crossing_of[i] = label[root];
+    }
+  }
+
+  // 3. Approximate transversal sides of each crossing: regression on the
+  // extremities of its longer long sides.
+  const int crossings =
+      m == 0 ? 0
+             : *std::max_element(crossing_of.begin(), crossing_of.end()) + 1;
+  for (int i = 0; i < m; ++i) {
+    VLOG(2) << "band " << i << ": sides " << pairs[i].lo << " " << pairs[i].hi
+            << " set " << sides[pairs[i].lo].direction_set << " lateral "
+            << sides[pairs[i].lo].lateral_m << " "
+            << sides[pairs[i].hi].lateral_m << " extent " << pairs[i].begin
+            << " " << pairs[i].end << " crossing " << crossing_of[i];
+  }
+  std::vector<PlaneLine> begin_lines(crossings), end_lines(crossings);
+  for (int c = 0; c < crossings; ++c) {
+    double longest = 0.0;
+    Eigen::Vector2d along = Eigen::Vector2d::UnitX();
+    for (int i = 0; i < m; ++i) {
+      if (crossing_of[i] != c) continue;
+      longest = std::max(longest, pairs[i].end - pairs[i].begin);
+      along = sides[pairs[i].lo].direction_2d;
+    }
+    const Eigen::Vector2d across(-along.y(), along.x());
+    std::vector<Eigen::Vector2d> begins, ends;
+    for (int i = 0; i < m; ++i) {
+      if (crossing_of[i] != c) continue;
+      if (pairs[i].end - pairs[i].begin <
+          options.extremity_length_fraction * longest) {
+        continue;
+      }
+      // The ends of the band's overlap, in the middle of the band.
+      const double middle =
+          0.5 * (sides[pairs[i].lo].lateral_m + sides[pairs[i].hi].lateral_m);
+      begins.push_back(pairs[i].begin * along + middle * across);
+      ends.push_back(pairs[i].end * along + middle * across);
+    }
+    begin_lines[c] = FitRobustPlaneLine(begins, across);
+    end_lines[c] = FitRobustPlaneLine(ends, across);
+    VLOG(2) << "crossing " << c << ": begin line "
+            << begin_lines[c].point.transpose() << " dir "
+            << begin_lines[c].direction.transpose() << ", end line "
+            << end_lines[c].point.transpose() << " dir "
+            << end_lines[c].direction.transpose() << " across "
+            << across.transpose();
+  }
+
+  // 4. Each band: plane, transversal sides, vertices.
+  std::vector<Band> bands;
+  for (int i = 0; i < m; ++i) {
+    const LongSide& lo = sides[pairs[i].lo];
+    const LongSide& hi = sides[pairs[i].hi];
+    const Eigen::Vector2d along = lo.direction_2d;
+    const Eigen::Vector2d across = lo.Normal2d();
+    std::vector<Eigen::Vector3d> support;
+    for (int s : {pairs[i].lo, pairs[i].hi}) {
+      for (int p : sides[s].support) {
+        support.push_back(detection.points[p].p_body);
+      }
+    }
+    BandPlaneFit plane_fit;
+    if (!FitBandPlane(support, lo.direction_body, frame.normal,
+                      options.min_sigma_m, &plane_fit)) {
+      continue;
+    }
+    const RoadPlane& plane = plane_fit.plane;
+    VLOG(2) << "band " << i << ": plane normal "
+            << plane.normal_body.transpose() << " rms " << plane_fit.rms_m
+            << " n " << plane_fit.count << " side height rms "
+            << lo.height_rms_m << " " << hi.height_rms_m << " lateral rms "
+            << lo.lateral_rms_m << " " << hi.lateral_rms_m;
+    const double lateral_lo = lo.lateral_m + options.side_margin_m;
+    const double lateral_hi = hi.lateral_m - options.side_margin_m;
+    const int crossing = crossing_of[i];
+    // Search areas (3D corners on the band plane), begin then end.
+    std::array<std::array<Eigen::Vector3d, 4>, 2> areas_3d;
+    for (int e = 0; e < 2; ++e) {
+      const PlaneLine& line =
+          e == 0 ? begin_lines[crossing] : end_lines[crossing];
+      const double s = options.transversal_search_m;
+      const Eigen::Vector2d corners[4] = {
+          AtLateral(line, along, across, lateral_lo, -s),
+          AtLateral(line, along, across, lateral_hi, -s),
+          AtLateral(line, along, across, lateral_hi, s),
+          AtLateral(line, along, across, lateral_lo, s)};
+      for (int k = 0; k < 4; ++k) {
+        areas_3d[e][k] = OnBandPlane(frame, plane, corners[k]);
+      }
+    }
+    // The band direction and the expected transversal normal in the image.
+    const Eigen::Vector3d band_centre =
+        0.5 * (OnBandPlane(frame, plane, frame.To2d(lo.point_body)) +
+               OnBandPlane(frame, plane, frame.To2d(hi.point_body)));
+    std::array<Eigen::Vector3d, 4> vertex_sum;
+    vertex_sum.fill(Eigen::Vector3d::Zero());
+    std::array<std::array<Eigen::Vector3d, 4>, 2> vertex_side;
+    double line_sigma_px[2][2] = {{0, 0}, {0, 0}};
+    double contrast = 0.0;
+    int views = 0;
+    bool failed = false;
+    for (int side = 0; side < 2 && !failed; ++side) {
+      // The band's approximate corners must be seen (the band is fully
+      // visible); its search areas may run out of the image.
+      Area areas[2];
+      bool visible = true;
+      for (int e = 0; e < 2; ++e) {
+        for (int k = 0; k < 4; ++k) {
+          if (!rectification.ProjectToRectified(side, areas_3d[e][k],
+                                                &areas[e][k])) {
+            visible = false;
+          }
+        }
+        for (int k : {0, 1}) {
+          const Eigen::Vector2d corner = 0.5 * (areas[e][k] + areas[e][3 - k]);
+          // (The valid mask holds for both images: a road point has the
+          // same pixel in both.)
+          visible = visible && rectification.IsValid(corner.x(), corner.y());
+        }
+      }
+      if (!visible) {
+        failed = true;
+        VLOG(2) << "band " << i << " side " << side
+                << ": band corners not visible " << areas[0][0].transpose()
+                << " / " << areas[0][1].transpose() << " / "
+                << areas[1][0].transpose() << " / " << areas[1][1].transpose();
+        break;
+      }
+      Eigen::Vector2d c0, c1, t0, t1;
+      const Eigen::Vector3d dir3 = plane_fit.x_axis;
+      if (!rectification.ProjectToRectified(side, band_centre, &c0) ||
+          !rectification.ProjectToRectified(side, band_centre + dir3, &c1) ||
+          !rectification.ProjectToRectified(side, areas_3d[0][0], &t0) ||
+          !rectification.ProjectToRectified(side, areas_3d[0][1], &t1)) {
+        failed = true;
+        VLOG(2) << "band " << i << " side " << side << ": projection";
+        break;
+      }
+      const Eigen::Vector2d band_direction = (c1 - c0).normalized();
+      const Eigen::Vector2d transversal = (t1 - t0).normalized();
+      Eigen::Vector2d expected_normal(-transversal.y(), transversal.x());
+      // At the begin side the image brightens into the band (along the band
+      // direction), at the end side against it.
+      if (expected_normal.dot(band_direction) < 0.0) {
+        expected_normal = -expected_normal;
+      }
+      std::vector<ImageLine> candidates_e[2];
+      for (int e = 0; e < 2; ++e) {
+        candidates_e[e] = HoughTransversalCandidates(
+            edges[side], areas[e], e == 0 ? expected_normal : -expected_normal,
+            options);
+        if (debug != nullptr && side == 0) {
+          debug->search_areas.push_back(areas[e]);
+          for (const ImageLine& line : candidates_e[e]) {
+            const Eigen::Vector2d d(-line.normal.y(), line.normal.x());
+            const Eigen::Vector2d p = line.rho * line.normal;
+            const double t_a = (areas[e][0] - p).dot(d);
+            const double t_b = (areas[e][1] - p).dot(d);
+            debug->candidate_lines.push_back({p + t_a * d, p + t_b * d});
+          }
+        }
+      }
+      int t = -1, l = -1;
+      if (!ChooseTransversalPair(candidates_e[0], candidates_e[1],
+                                 band_direction, options, &t, &l)) {
+        failed = true;
+        VLOG(2) << "band " << i << " side " << side << ": no transversal pair";
+        break;
+      }
+      ImageLine transversal_lines[2] = {candidates_e[0][t], candidates_e[1][l]};
+      for (int e = 0; e < 2; ++e) {
+        if (!RefineImageLine(edges[side], areas[e], options,
+                             &transversal_lines[e])) {
+          failed = true;
+          VLOG(2) << "band " << i << " side " << side << ": refinement failed";
+          break;
+        }
+        line_sigma_px[side][e] = std::max(
+            options.min_line_sigma_px,
+            transversal_lines[e].rms_px /
+                std::sqrt(static_cast<double>(transversal_lines[e].support)));
+        contrast += transversal_lines[e].gamma.norm() /
+                    std::max(1, transversal_lines[e].support);
+      }
+      if (failed) break;
+      // Long sides in this image.
+      ImageLine long_lines[2];
+      for (int k = 0; k < 2; ++k) {
+        const LongSide& s = k == 0 ? lo : hi;
+        Eigen::Vector2d a, b;
+        if (!rectification.ProjectToRectified(side, s.Begin(), &a) ||
+            !rectification.ProjectToRectified(side, s.End(), &b)) {
+          failed = true;
+          VLOG(2) << "band " << i << " side " << side
+                  << ": long side projection";
+          break;
+        }
+        long_lines[k] = LineThrough(a, b);
+      }
+      if (failed) break;
+      // Vertices: 0 = lo x begin, 1 = hi x begin, 2 = hi x end, 3 = lo x end.
+      const int long_of[4] = {0, 1, 1, 0};
+      const int end_of[4] = {0, 0, 1, 1};
+      const Eigen::Vector3d centre = side == 0
+                                         ? rectification.left_centre_body()
+                                         : rectification.right_centre_body();
+      for (int v = 0; v < 4 && !failed; ++v) {
+        Eigen::Vector2d xy;
+        if (!Intersect(long_lines[long_of[v]], transversal_lines[end_of[v]],
+                       &xy) ||
+            !plane.IntersectRay(centre, rectification.RayBody(side, xy),
+                                &vertex_side[side][v])) {
+          failed = true;
+          VLOG(2) << "band " << i << " side " << side
+                  << ": vertex intersection";
+        }
+      }
+      if (failed) break;
+      for (int v = 0; v < 4; ++v) vertex_sum[v] += vertex_side[side][v];
+      ++views;
+    }
+    if (failed || views != 2) continue;
+
+    Band band;
+    band.plane = plane;
+    band.crossing = crossing;
+    band.sides[0] = pairs[i].lo;
+    band.sides[1] = pairs[i].hi;
+    double disagreement = 0.0;
+    for (int v = 0; v < 4; ++v) {
+      band.vertices_body[v] = vertex_sum[v] / views;
+      disagreement = std::max(disagreement,
+                              (vertex_side[0][v] - vertex_side[1][v]).norm());
+    }
+    band.stereo_disagreement_m = disagreement;
+    const Eigen::Vector3d band_middle =
+        0.25 * (band.vertices_body[0] + band.vertices_body[1] +
+                band.vertices_body[2] + band.vertices_body[3]);
+    if ((band_middle - rectification.left_centre_body()).norm() >
+        options.max_band_range_m) {
+      continue;
+    }
+    if (disagreement > options.max_stereo_disagreement_m) {
+      VLOG(2) << "band " << i << ": stereo disagreement " << disagreement;
+      continue;
+    }
+    const Eigen::Vector3d& v0 = band.vertices_body[0];
+    const Eigen::Vector3d& v1 = band.vertices_body[1];
+    const Eigen::Vector3d& v2 = band.vertices_body[2];
+    const Eigen::Vector3d& v3 = band.vertices_body[3];
+    band.length_m = 0.5 * ((v3 - v0).norm() + (v2 - v1).norm());
+    band.width_m = 0.5 * ((v1 - v0).norm() + (v2 - v3).norm()) *
+                   std::abs(plane_fit.y_axis.dot((v1 - v0).normalized()));
+    if (band.length_m < zebra.min_band_length_m - 0.5 ||
+        band.length_m > zebra.max_band_length_m + 0.5) {
+      VLOG(2) << "band " << i << ": length " << band.length_m;
+      continue;
+    }
+
+    // Covariance: along the band from the transversal line fits, across
+    // from the long side regression, and the band plane's height error,
+    // which moves a vertex along its viewing ray.
+    const Eigen::Vector3d plane_normal = plane.normal_body;
+    const Eigen::Vector3d x_axis = plane_fit.x_axis;
+    const Eigen::Vector3d y_axis = plane_fit.y_axis;
+    for (int v = 0; v < 4; ++v) {
+      const Eigen::Vector3d& p = band.vertices_body[v];
+      const int e = v == 0 || v == 1 ? 0 : 1;
+      const LongSide& s = v == 0 || v == 3 ? lo : hi;
+      const Eigen::Vector3d ray =
+          (p - rectification.left_centre_body()).normalized();
+      const double depth = (rectification.R_body_virt().transpose() *
+                            (p - rectification.left_centre_body()))
+                               .z();
+      const double metres_per_px = depth / rectification.focal_px();
+      // The two images' lines are independent estimates.
+      const double sigma_px =
+          0.5 * std::hypot(line_sigma_px[0][e], line_sigma_px[1][e]);
+      const double sigma_along = sigma_px * metres_per_px;
+      const double sigma_across = std::max(
+          options.min_sigma_m,
+          s.lateral_rms_m / std::sqrt(static_cast<double>(s.support.size())));
+      const double sigma_height =
+          std::max(options.min_sigma_m, std::sqrt(plane_fit.HeightVariance(p)));
+      const Eigen::Vector3d along_ray = ray / std::abs(plane_normal.dot(ray));
+      band.covariances_body[v] =
+          sigma_along * sigma_along * x_axis * x_axis.transpose() +
+          sigma_across * sigma_across * y_axis * y_axis.transpose() +
+          sigma_height * sigma_height * along_ray * along_ray.transpose();
+    }
+
+    // Score: width as specified, stereo agreement, contrast, flatness.
+    const double width_term = std::exp(
+        -0.5 * std::pow((band.width_m - zebra.band_width_m) / 0.05, 2));
+    const double stereo_term =
+        std::exp(-0.5 * std::pow(disagreement / 0.02, 2));
+    const double contrast_term = std::min(1.0, contrast / (4.0 * 10.0));
+    const double flat_term =
+        std::exp(-0.5 * std::pow(plane_fit.rms_m / 0.02, 2));
+    band.score = std::clamp(
+        width_term * stereo_term * contrast_term * flat_term, 0.0, 1.0);
+    bands.push_back(band);
+  }
+  return bands;
+}
+
+}  // namespace zebrageo

@@ -1,0 +1,152 @@
+// Zebra band modelling (Soheilian et al., section 5): pairs of long sides
+// become bands, each band gets its own 3D plane, its transversal sides are
+// found by a Hough transform in the rectified images, and its vertices are
+// the image intersections of long and transversal sides projected onto the
+// band's plane.
+//
+// Frames: body (FRD) for 3D, metres; rectified image pixels for 2D (see
+// road_rectification.h). A band's vertices are in order around it: 0 and 1
+// on its "begin" transversal side, 2 and 3 on its "end" side, 0 and 3 on one
+// long side, 1 and 2 on the other.
+#ifndef ZEBRAGEO_RECONSTRUCTION_BAND_MODELING_H_
+#define ZEBRAGEO_RECONSTRUCTION_BAND_MODELING_H_
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "reconstruction/long_sides.h"
+#include "reconstruction/road_rectification.h"
+#include "reconstruction/subpixel_edges.h"
+
+namespace zebrageo {
+
+struct BandOptions {
+  // Long sides of one band are parallel within this angle.
+  double max_side_angle_rad = 0.05;
+  // They overlap (along the band) over at least this share of the shorter.
+  double min_side_overlap_fraction = 0.5;
+  // The approximate transversal sides of a crossing come from the ends of
+  // its long sides at least this share of the longest (the paper's 80 %).
+  double extremity_length_fraction = 0.8;
+  // Search area: this far on each side of the approximate transversal side
+  // (the paper's 40 cm), inset from the long sides by side_margin_m so the
+  // long edges and the corners do not vote.
+  double transversal_search_m = 0.4;
+  double side_margin_m = 0.04;
+  // Hough: lines within this angle of the crossing's mean transversal
+  // direction (the paper's 20 degrees); an edge point votes for angles
+  // within point_angle_tolerance_rad of its own edge direction.
+  double transversal_max_angle_rad = 0.35;
+  double point_angle_tolerance_rad = 0.17;
+  double hough_angle_step_rad = 0.0087;
+  double hough_rho_step_px = 1.0;
+  // Local Hough maxima above this share of the highest are candidates, and
+  // pairs whose gradient score is above this share of the best are
+  // compared by their gradient directions (the paper's 80 % twice).
+  double hough_score_fraction = 0.8;
+  double pair_score_fraction = 0.8;
+  // Pixels whose gradient norm is below this do not vote (grey levels per
+  // pixel; a far transversal side is blurred along the road, so its
+  // gradient is weak but wide).
+  double hough_min_gradient = 2.0;
+  // Sub-pixel refinement of a Hough line: gradient profiles across it
+  // within this distance, at least this many along it.
+  double refine_distance_px = 6.0;
+  int min_transversal_points = 8;
+  // The left and right images give two estimates of each vertex; a band
+  // whose estimates differ by more is dropped.
+  double max_stereo_disagreement_m = 0.05;
+  // Bands of one direction whose long sides are closer (across) than this
+  // and overlap along the band belong to one crossing.
+  double max_crossing_gap_m = 2.2;
+  // Bands whose centre is farther than this from the left camera are not
+  // reported: their along-track precision degrades with the square of the
+  // range, and a closer exposure sees them better.
+  double max_band_range_m = 15.05;
+  // Floor of the image line position's standard deviation in the
+  // covariance (resampling and model errors).
+  double min_line_sigma_px = 0.1;
+  // Floor of the long side and band plane standard deviations.
+  double min_sigma_m = 0.002;
+
+  std::string Check() const;
+};
+
+// A line of a rectified image: normal . x = rho, |normal| = 1.
+struct ImageLine {
+  Eigen::Vector2d normal = Eigen::Vector2d::UnitY();
+  double rho = 0.0;
+  double votes = 0.0;
+  // The paper's Gamma: sum of the image gradient along the line inside the
+  // search area.
+  Eigen::Vector2d gamma = Eigen::Vector2d::Zero();
+  int support = 0;      // edge points of the least-squares refinement
+  double rms_px = 0.0;  // their residuals
+  double Distance(const Eigen::Vector2d& x) const {
+    return normal.dot(x) - rho;
+  }
+};
+
+// Hough candidates for a transversal side among the pixels inside the
+// convex `area` (4 corners, rectified pixels): lines whose normal is within
+// transversal_max_angle_rad of `expected_normal` (oriented: the expected
+// polarity, the image brightening into the band). Each pixel votes with its
+// gradient norm for the lines through it whose normal is within
+// point_angle_tolerance_rad of its gradient. Local maxima above
+// hough_score_fraction of the best, strongest first, each with its gamma.
+std::vector<ImageLine> HoughTransversalCandidates(
+    const EdgeMap& edges, const std::array<Eigen::Vector2d, 4>& area,
+    const Eigen::Vector2d& expected_normal, const BandOptions& options);
+
+// The paper's equations 2 and 3: among the pairs (begin candidate t, end
+// candidate l) whose score |gamma_t| + |gamma_l| is above
+// pair_score_fraction of the best, the one whose gammas are the most
+// opposite (smallest dot product). Begin candidates must have gamma along
+// +band_direction (the image brightens into the band) and end candidates
+// along -band_direction. False when no pair qualifies.
+bool ChooseTransversalPair(const std::vector<ImageLine>& begin,
+                           const std::vector<ImageLine>& end,
+                           const Eigen::Vector2d& band_direction,
+                           const BandOptions& options, int* t, int* l);
+
+// Sub-pixel refinement of `line` inside `area`: centroids of the gradient
+// profiles across it (polarity of its gamma) fitted by weighted least
+// squares. False with fewer than min_transversal_points profiles.
+bool RefineImageLine(const EdgeMap& edges,
+                     const std::array<Eigen::Vector2d, 4>& area,
+                     const BandOptions& options, ImageLine* line);
+
+struct Band {
+  std::array<Eigen::Vector3d, 4> vertices_body;
+  std::array<Eigen::Matrix3d, 4> covariances_body;
+  RoadPlane plane;          // the band's own plane
+  double score = 0.0;       // 0..1
+  int crossing = 0;         // index of the crossing within the stereo pair
+  int sides[2] = {-1, -1};  // LongSideDetection::sides
+  double width_m = 0.0;
+  double length_m = 0.0;
+  double stereo_disagreement_m = 0.0;
+};
+
+// What band modelling tried, for debug images (left rectified pixels).
+struct BandModelingDebug {
+  std::vector<std::array<Eigen::Vector2d, 4>> search_areas;
+  std::vector<std::array<Eigen::Vector2d, 2>> candidate_lines;
+  std::vector<std::array<Eigen::Vector2d, 2>> band_pairs;  // long side pairs
+};
+
+// Builds the bands of one stereo pair. `edges[0]`, `edges[1]`: the left and
+// right rectified edge maps. Deterministic.
+std::vector<Band> ModelBands(const LongSideDetection& detection,
+                             const PlaneFrame& frame,
+                             const RoadRectification& rectification,
+                             const EdgeMap edges[2],
+                             const ZebraSpecification& zebra,
+                             const BandOptions& options,
+                             BandModelingDebug* debug);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_RECONSTRUCTION_BAND_MODELING_H_

@@ -1,0 +1,549 @@
+#include "reconstruction/long_sides.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace zebrageo {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kDirectionBins = 180;
+
+// Total least squares line through 2D points: centre and unit direction.
+void FitLine2d(const std::vector<Eigen::Vector2d>& points,
+               const std::vector<int>& support, Eigen::Vector2d* centre,
+               Eigen::Vector2d* direction) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (int i : support) mean += points[i];
+  mean /= static_cast<double>(support.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (int i : support) {
+    scatter += (points[i] - mean) * (points[i] - mean).transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
+  *centre = mean;
+  *direction = solver.eigenvectors().col(1);
+}
+
+// A set of collinear supports being grouped.
+struct Group {
+  std::vector<int> support;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();  // along `axis`
+  double t_min = 0.0;  // extent along direction from centre
+  double t_max = 0.0;
+  double rms_m = 0.0;  // perpendicular residuals
+  double Length() const { return t_max - t_min; }
+  Eigen::Vector2d Begin() const { return centre + t_min * direction; }
+  Eigen::Vector2d End() const { return centre + t_max * direction; }
+};
+
+Group MakeGroup(const std::vector<Eigen::Vector2d>& points,
+                std::vector<int> support, const Eigen::Vector2d& axis) {
+  Group g;
+  g.support = std::move(support);
+  FitLine2d(points, g.support, &g.centre, &g.direction);
+  if (g.direction.dot(axis) < 0.0) g.direction = -g.direction;
+  const Eigen::Vector2d normal(-g.direction.y(), g.direction.x());
+  g.t_min = 1e30;
+  g.t_max = -1e30;
+  double sum_squares = 0.0;
+  for (int i : g.support) {
+    const Eigen::Vector2d d = points[i] - g.centre;
+    const double t = d.dot(g.direction);
+    g.t_min = std::min(g.t_min, t);
+    g.t_max = std::max(g.t_max, t);
+    sum_squares += d.dot(normal) * d.dot(normal);
+  }
+  g.rms_m = std::sqrt(sum_squares / g.support.size());
+  return g;
+}
+
+double PerpendicularDistance(const Group& g, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d d = p - g.centre;
+  return std::abs(d.x() * g.direction.y() - d.y() * g.direction.x());
+}
+
+struct GroupingThresholds {
+  double max_gap_m;
+  double max_offset_m;
+  double max_angle_rad;
+};
+
+// Greedy best-first merging of collinear groups (an approximation of Jang
+// and Hong's globally favourable grouping): candidate links are sorted by a
+// normalised cost of gap, offset and angle, and merged while the merged
+// group stays a line (rms below the offset threshold).
+std::vector<Group> MergeCollinear(const std::vector<Eigen::Vector2d>& points,
+                                  std::vector<Group> groups,
+                                  const Eigen::Vector2d& axis,
+                                  const GroupingThresholds& limits) {
+  for (bool merged = true; merged;) {
+    merged = false;
+    struct Link {
+      double cost;
+      int i, j;
+    };
+    std::vector<Link> links;
+    const int n = static_cast<int>(groups.size());
+    for (int i = 0; i < n; ++i) {
+      for (int j = i + 1; j < n; ++j) {
+        const Group& a = groups[i];
+        const Group& b = groups[j];
+        const double angle =
+            std::acos(std::min(1.0, std::abs(a.direction.dot(b.direction))));
+        // A short group's direction is uncertain: its angle may exceed the
+        // threshold as long as its ends stay within the offset (below).
+        const double shorter_length = std::min(a.Length(), b.Length());
+        const double max_angle =
+            std::max(limits.max_angle_rad,
+                     std::atan2(limits.max_offset_m, 0.5 * shorter_length));
+        if (angle > max_angle) continue;
+        const double a0 = (a.Begin() - a.centre).dot(axis) + a.centre.dot(axis);
+        const double a1 = (a.End() - a.centre).dot(axis) + a.centre.dot(axis);
+        const double b0 = (b.Begin() - b.centre).dot(axis) + b.centre.dot(axis);
+        const double b1 = (b.End() - b.centre).dot(axis) + b.centre.dot(axis);
+        const double gap = std::max(b0 - a1, a0 - b1);
+        if (gap > limits.max_gap_m) continue;
+        // The shorter group's ends must lie on the longer group's line.
+        const Group& longer = a.Length() >= b.Length() ? a : b;
+        const Group& shorter = a.Length() >= b.Length() ? b : a;
+        const double offset =
+            std::max(PerpendicularDistance(longer, shorter.Begin()),
+                     PerpendicularDistance(longer, shorter.End()));
+        if (offset > limits.max_offset_m) continue;
+        links.push_back({std::max(0.0, gap) / limits.max_gap_m +
+                             offset / limits.max_offset_m + angle / max_angle,
+                         i, j});
+      }
+    }
+    std::sort(links.begin(), links.end(), [](const Link& x, const Link& y) {
+      return x.cost < y.cost || (x.cost == y.cost && x.i < y.i) ||
+             (x.cost == y.cost && x.i == y.i && x.j < y.j);
+    });
+    std::vector<char> touched(groups.size(), 0);
+    std::vector<Group> next;
+    for (const Link& link : links) {
+      if (touched[link.i] || touched[link.j]) continue;
+      std::vector<int> support = groups[link.i].support;
+      support.insert(support.end(), groups[link.j].support.begin(),
+                     groups[link.j].support.end());
+      Group joined = MakeGroup(points, std::move(support), axis);
+      if (joined.rms_m > limits.max_offset_m) continue;
+      touched[link.i] = touched[link.j] = 1;
+      next.push_back(std::move(joined));
+      merged = true;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (!touched[i]) next.push_back(std::move(groups[i]));
+    }
+    groups = std::move(next);
+  }
+  return groups;
+}
+
+}  // namespace
+
+std::string ZebraSpecification::Check() const {
+  std::ostringstream error;
+  if (!(band_width_m > 0.05)) {
+    error << "band_width_m = " << band_width_m << ": must be > 0.05";
+  } else if (!(band_width_tolerance_m > 0.0 &&
+               band_width_tolerance_m < band_width_m)) {
+    error << "band_width_tolerance_m = " << band_width_tolerance_m
+          << ": must be in (0, band_width_m)";
+  } else if (!(min_band_length_m > band_width_m)) {
+    error << "min_band_length_m = " << min_band_length_m
+          << ": must be > band_width_m";
+  } else if (!(max_band_length_m >= min_band_length_m)) {
+    error << "max_band_length_m = " << max_band_length_m
+          << ": must be >= min_band_length_m";
+  }
+  return error.str();
+}
+
+std::string LongSideOptions::Check() const {
+  std::ostringstream error;
+  if (!(polygon_tolerance_m > 0.0)) {
+    error << "polygon_tolerance_m = " << polygon_tolerance_m << ": must be > 0";
+  } else if (!(max_chain_gap_m > 0.0)) {
+    error << "max_chain_gap_m = " << max_chain_gap_m << ": must be > 0";
+  } else if (!(min_segment_length_m > 0.0)) {
+    error << "min_segment_length_m = " << min_segment_length_m
+          << ": must be > 0";
+  } else if (!(direction_tolerance_rad > 0.0 &&
+               direction_tolerance_rad < 0.8)) {
+    error << "direction_tolerance_rad = " << direction_tolerance_rad
+          << ": must be in (0, 0.8)";
+  } else if (max_directions < 1) {
+    error << "max_directions = " << max_directions << ": must be >= 1";
+  } else if (!(accumulator_cell_m > 0.0)) {
+    error << "accumulator_cell_m = " << accumulator_cell_m << ": must be > 0";
+  } else if (!(high_vote_fraction > 0.0 &&
+               high_vote_fraction >= low_vote_fraction)) {
+    error << "high_vote_fraction = " << high_vote_fraction
+          << ": must be > 0 and >= low_vote_fraction";
+  } else if (!(low_vote_fraction > 0.0)) {
+    error << "low_vote_fraction = " << low_vote_fraction << ": must be > 0";
+  } else if (!(pass1_max_gap_m > 0.0 && pass1_max_offset_m > 0.0 &&
+               pass1_max_angle_rad > 0.0)) {
+    error << "pass1_max_gap_m, pass1_max_offset_m, pass1_max_angle_rad = "
+          << pass1_max_gap_m << ", " << pass1_max_offset_m << ", "
+          << pass1_max_angle_rad << ": must be > 0";
+  } else if (!(pass2_max_gap_m > 0.0 && pass2_max_offset_m > 0.0 &&
+               pass2_max_angle_rad > 0.0)) {
+    error << "pass2_max_gap_m, pass2_max_offset_m, pass2_max_angle_rad = "
+          << pass2_max_gap_m << ", " << pass2_max_offset_m << ", "
+          << pass2_max_angle_rad << ": must be > 0";
+  } else if (!(pass1_min_length_m >= 0.0)) {
+    error << "pass1_min_length_m = " << pass1_min_length_m << ": must be >= 0";
+  } else if (!(min_long_side_length_m > 0.0)) {
+    error << "min_long_side_length_m = " << min_long_side_length_m
+          << ": must be > 0";
+  }
+  return error.str();
+}
+
+PlaneFrame PlaneFrame::Make(const RoadPlane& plane,
+                            const Eigen::Vector3d& x_axis,
+                            const Eigen::Vector3d& point) {
+  PlaneFrame frame;
+  frame.normal = plane.normal_body.normalized();
+  frame.e1 = (x_axis - x_axis.dot(frame.normal) * frame.normal).normalized();
+  frame.e2 = frame.normal.cross(frame.e1);
+  frame.origin = plane.Project(point);
+  return frame;
+}
+
+std::vector<int> DouglasPeucker(const std::vector<Eigen::Vector2d>& polyline,
+                                double tolerance) {
+  const int n = static_cast<int>(polyline.size());
+  if (n <= 2) {
+    std::vector<int> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    return all;
+  }
+  std::vector<char> keep(n, 0);
+  keep[0] = keep[n - 1] = 1;
+  std::vector<std::pair<int, int>> stack = {{0, n - 1}};
+  while (!stack.empty()) {
+    const auto [first, last] = stack.back();
+    stack.pop_back();
+    const Eigen::Vector2d a = polyline[first];
+    const Eigen::Vector2d ab = polyline[last] - a;
+    const double length = ab.norm();
+    int worst = -1;
+    double worst_distance = tolerance;
+    for (int k = first + 1; k < last; ++k) {
+      const Eigen::Vector2d ak = polyline[k] - a;
+      const double distance =
+          length > 1e-12 ? std::abs(ab.x() * ak.y() - ab.y() * ak.x()) / length
+                         : ak.norm();
+      if (distance > worst_distance) {
+        worst_distance = distance;
+        worst = k;
+      }
+    }
+    if (worst >= 0) {
+      keep[worst] = 1;
+      stack.push_back({first, worst});
+      stack.push_back({worst, last});
+    }
+  }
+  std::vector<int> kept;
+  for (int k = 0; k < n; ++k) {
+    if (keep[k]) kept.push_back(k);
+  }
+  return kept;
+}
+
+Eigen::Vector2d PrincipalDirection(const std::vector<Segment2d>& segments,
+                                   double tolerance_rad, double* weight) {
+  std::vector<double> histogram(kDirectionBins, 0.0);
+  for (const Segment2d& s : segments) {
+    const Eigen::Vector2d d = s.b - s.a;
+    double angle = std::atan2(d.y(), d.x());
+    if (angle < 0.0) angle += kPi;
+    const int bin = std::min(kDirectionBins - 1,
+                             static_cast<int>(angle / kPi * kDirectionBins));
+    histogram[bin] += s.Length();
+  }
+  // Circular smoothing over +-2 degrees.
+  const double kernel[5] = {1, 2, 3, 2, 1};
+  int best_bin = 0;
+  double best = -1.0;
+  for (int b = 0; b < kDirectionBins; ++b) {
+    double value = 0.0;
+    for (int k = -2; k <= 2; ++k) {
+      value +=
+          kernel[k + 2] * histogram[(b + k + kDirectionBins) % kDirectionBins];
+    }
+    if (value > best) {
+      best = value;
+      best_bin = b;
+    }
+  }
+  // Refine: length-weighted mean of doubled angles near the peak.
+  const double peak = (best_bin + 0.5) * kPi / kDirectionBins;
+  double c = 0.0, s = 0.0, total = 0.0;
+  for (const Segment2d& seg : segments) {
+    const Eigen::Vector2d d = seg.b - seg.a;
+    const double angle = std::atan2(d.y(), d.x());
+    double difference = std::remainder(angle - peak, kPi);
+    if (std::abs(difference) > tolerance_rad) continue;
+    c += seg.Length() * std::cos(2.0 * (peak + difference));
+    s += seg.Length() * std::sin(2.0 * (peak + difference));
+    total += seg.Length();
+  }
+  if (weight != nullptr) *weight = total;
+  const double mean = total > 0.0 ? 0.5 * std::atan2(s, c) : peak;
+  return Eigen::Vector2d(std::cos(mean), std::sin(mean));
+}
+
+std::vector<AccumulatorComponent> ParallelLineComponents(
+    const std::vector<Segment2d>& segments, const Eigen::Vector2d& direction,
+    const ZebraSpecification& zebra, const LongSideOptions& options) {
+  std::vector<AccumulatorComponent> components;
+  if (segments.empty()) return components;
+  const Eigen::Vector2d normal(-direction.y(), direction.x());
+  const double cell = options.accumulator_cell_m;
+  double low_s = 1e30, high_s = -1e30;
+  for (const Segment2d& s : segments) {
+    low_s = std::min({low_s, s.a.dot(normal), s.b.dot(normal)});
+    high_s = std::max({high_s, s.a.dot(normal), s.b.dot(normal)});
+  }
+  const double origin = low_s - cell;
+  const int cells = static_cast<int>((high_s - origin) / cell) + 2;
+  std::vector<double> votes(cells, 0.0);
+  for (const Segment2d& s : segments) {
+    const double along = std::abs((s.b - s.a).dot(direction));
+    const double s0 = std::min(s.a.dot(normal), s.b.dot(normal)) - origin;
+    const double s1 = std::max(s.a.dot(normal), s.b.dot(normal)) - origin;
+    const int c0 = static_cast<int>(s0 / cell);
+    const int c1 = static_cast<int>(s1 / cell);
+    if (c0 == c1) {
+      votes[c0] += along;
+      continue;
+    }
+    // Each cell gets the part of the segment that projects into it.
+    for (int c = c0; c <= c1; ++c) {
+      const double overlap =
+          std::min(s1, (c + 1) * cell) - std::max(s0, c * cell);
+      votes[c] += along * std::max(0.0, overlap) / (s1 - s0);
+    }
+  }
+  const double high = options.high_vote_fraction * zebra.min_band_length_m;
+  const double low = options.low_vote_fraction * zebra.min_band_length_m;
+  // Runs above the low threshold; a run holding several lines (a band side
+  // next to a kerb and a lane line) is split at its valleys: where the
+  // votes drop below half of the peaks on both sides.
+  auto emit = [&](int first, int last) {  // cells [first, last)
+    double peak = 0.0, sum = 0.0, moment = 0.0;
+    for (int k = first; k < last; ++k) {
+      peak = std::max(peak, votes[k]);
+      sum += votes[k];
+      moment += votes[k] * (origin + (k + 0.5) * cell);
+    }
+    if (peak < high) return;
+    AccumulatorComponent component;
+    component.lateral_m = moment / sum;
+    component.low_m = origin + first * cell;
+    component.high_m = origin + last * cell;
+    component.peak_votes_m = peak;
+    components.push_back(component);
+  };
+  for (int c = 0; c < cells;) {
+    if (votes[c] < low) {
+      ++c;
+      continue;
+    }
+    int end = c;
+    while (end < cells && votes[end] >= low) ++end;
+    int first = c;
+    double left_peak = 0.0;
+    for (int k = c; k < end; ++k) {
+      left_peak = std::max(left_peak, votes[k]);
+      // Is k a valley: below half of the left peak and of the highest
+      // cell to its right within the run?
+      if (votes[k] >= 0.5 * left_peak) continue;
+      double right_peak = 0.0;
+      for (int r = k + 1; r < end; ++r)
+        right_peak = std::max(right_peak, votes[r]);
+      if (votes[k] >= 0.5 * right_peak) continue;
+      // Split at the lowest cell of this dip.
+      int valley = k;
+      while (valley + 1 < end && votes[valley + 1] <= votes[valley]) ++valley;
+      emit(first, valley + 1);
+      first = valley + 1;
+      left_peak = 0.0;
+      k = valley;
+    }
+    emit(first, end);
+    c = end;
+  }
+  for (AccumulatorComponent& a : components) {
+    for (const AccumulatorComponent& b : components) {
+      if (std::abs(std::abs(a.lateral_m - b.lateral_m) - zebra.band_width_m) <=
+          zebra.band_width_tolerance_m) {
+        a.paired = true;
+      }
+    }
+  }
+  return components;
+}
+
+LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
+                                  const PlaneFrame& frame,
+                                  const ZebraSpecification& zebra,
+                                  const LongSideOptions& options) {
+  LongSideDetection result;
+  // Flatten, polygonise, refine each polygon side by regression.
+  for (const EdgeChain3d& chain : chains) {
+    const int first_index = static_cast<int>(result.points.size());
+    for (const EdgePoint3d& p : chain.points) {
+      result.points.push_back(p);
+      result.points_2d.push_back(frame.To2d(p.p_body));
+    }
+    const int n = static_cast<int>(chain.points.size());
+    int start = 0;
+    for (int k = 1; k <= n; ++k) {
+      const bool broken = k == n || (result.points_2d[first_index + k] -
+                                     result.points_2d[first_index + k - 1])
+                                            .norm() > options.max_chain_gap_m;
+      if (!broken) continue;
+      std::vector<Eigen::Vector2d> piece(
+          result.points_2d.begin() + first_index + start,
+          result.points_2d.begin() + first_index + k);
+      const std::vector<int> vertices =
+          DouglasPeucker(piece, options.polygon_tolerance_m);
+      for (size_t v = 0; v + 1 < vertices.size(); ++v) {
+        Segment2d segment;
+        for (int i = vertices[v]; i <= vertices[v + 1]; ++i) {
+          segment.support.push_back(first_index + start + i);
+        }
+        if (segment.support.size() < 4) continue;
+        Eigen::Vector2d centre, direction;
+        FitLine2d(result.points_2d, segment.support, &centre, &direction);
+        const Eigen::Vector2d p0 = result.points_2d[segment.support.front()];
+        const Eigen::Vector2d p1 = result.points_2d[segment.support.back()];
+        segment.a = centre + (p0 - centre).dot(direction) * direction;
+        segment.b = centre + (p1 - centre).dot(direction) * direction;
+        if (segment.Length() < options.min_segment_length_m) continue;
+        result.segments.push_back(std::move(segment));
+      }
+      start = k;
+    }
+  }
+
+  const double min_set_length =
+      2.0 * options.high_vote_fraction * zebra.min_band_length_m;
+  std::vector<char> used(result.segments.size(), 0);
+  for (int set = 0; set < options.max_directions; ++set) {
+    std::vector<Segment2d> remaining;
+    std::vector<int> remaining_index;
+    for (size_t i = 0; i < result.segments.size(); ++i) {
+      if (used[i]) continue;
+      remaining.push_back(result.segments[i]);
+      remaining_index.push_back(static_cast<int>(i));
+    }
+    if (remaining.empty()) break;
+    double weight = 0.0;
+    const Eigen::Vector2d direction =
+        PrincipalDirection(remaining, options.direction_tolerance_rad, &weight);
+    if (weight < min_set_length) break;
+    result.directions.push_back(direction);
+    std::vector<Segment2d> members;
+    for (size_t k = 0; k < remaining.size(); ++k) {
+      const Eigen::Vector2d d = (remaining[k].b - remaining[k].a).normalized();
+      if (std::abs(d.x() * direction.y() - d.y() * direction.x()) <=
+          std::sin(options.direction_tolerance_rad)) {
+        members.push_back(remaining[k]);
+        used[remaining_index[k]] = 1;
+      }
+    }
+    const std::vector<AccumulatorComponent> components =
+        ParallelLineComponents(members, direction, zebra, options);
+    const Eigen::Vector2d normal(-direction.y(), direction.x());
+    for (const AccumulatorComponent& component : components) {
+      VLOG(3) << "set " << set << " component at " << component.lateral_m
+              << " m [" << component.low_m << ", " << component.high_m
+              << "], peak " << component.peak_votes_m << " m, "
+              << (component.paired ? "paired" : "alone");
+      if (!component.paired) continue;
+      // Segments of the component, grouped in two passes.
+      std::vector<Group> groups;
+      for (const Segment2d& s : members) {
+        const double middle = 0.5 * (s.a + s.b).dot(normal);
+        if (middle < component.low_m - options.accumulator_cell_m ||
+            middle > component.high_m + options.accumulator_cell_m) {
+          continue;
+        }
+        groups.push_back(MakeGroup(result.points_2d, s.support, direction));
+      }
+      groups =
+          MergeCollinear(result.points_2d, std::move(groups), direction,
+                         {options.pass1_max_gap_m, options.pass1_max_offset_m,
+                          options.pass1_max_angle_rad});
+      groups.erase(std::remove_if(groups.begin(), groups.end(),
+                                  [&](const Group& g) {
+                                    return g.Length() <
+                                           options.pass1_min_length_m;
+                                  }),
+                   groups.end());
+      groups =
+          MergeCollinear(result.points_2d, std::move(groups), direction,
+                         {options.pass2_max_gap_m, options.pass2_max_offset_m,
+                          options.pass2_max_angle_rad});
+      for (Group& g : groups) {
+        VLOG(3) << "  group length " << g.Length() << " rms " << g.rms_m;
+        if (g.Length() < options.min_long_side_length_m) continue;
+        // 3D regression on the group's points.
+        LongSide side;
+        side.direction_set = set;
+        side.direction_2d = direction;
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (int i : g.support) mean += result.points[i].p_body;
+        mean /= static_cast<double>(g.support.size());
+        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+        for (int i : g.support) {
+          const Eigen::Vector3d d = result.points[i].p_body - mean;
+          scatter += d * d.transpose();
+        }
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+        Eigen::Vector3d axis = solver.eigenvectors().col(2);
+        if (axis.dot(frame.Direction3d(direction)) < 0.0) axis = -axis;
+        side.point_body = mean;
+        side.direction_body = axis;
+        side.t_begin = 1e30;
+        side.t_end = -1e30;
+        const Eigen::Vector3d across = frame.normal.cross(axis).normalized();
+        double lateral_ss = 0.0, height_ss = 0.0, contrast = 0.0;
+        for (int i : g.support) {
+          const Eigen::Vector3d d = result.points[i].p_body - mean;
+          const double t = d.dot(axis);
+          side.t_begin = std::min(side.t_begin, t);
+          side.t_end = std::max(side.t_end, t);
+          const Eigen::Vector3d r = d - t * axis;
+          lateral_ss += r.dot(across) * r.dot(across);
+          height_ss += r.dot(frame.normal) * r.dot(frame.normal);
+          contrast += result.points[i].gradient.dot(normal);
+        }
+        const double count = static_cast<double>(g.support.size());
+        side.lateral_rms_m = std::sqrt(lateral_ss / count);
+        side.height_rms_m = std::sqrt(height_ss / count);
+        side.contrast = contrast / count;
+        side.lateral_m = frame.To2d(mean).dot(normal);
+        side.support = std::move(g.support);
+        result.sides.push_back(std::move(side));
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace zebrageo

@@ -1,0 +1,203 @@
+// 3D zebra-crossing reconstruction from the stereo pairs of a survey
+// (Soheilian, Paparoditis, Boldo, Rudant: "3D zebra-crossing reconstruction
+// from stereo rig images of a ground-based mobile mapping system", ISPRS
+// 2006), GitHub issue 5.
+//
+// For each stereo pair of each exposure:
+//   1. rectification to road-plane ("vertical") epipolar geometry,
+//      distortion removed (road_rectification.h);
+//   2. sub-pixel Canny/Devernay edges and chains (subpixel_edges.h);
+//   3. edge matching by dynamic programming inside the search volume (a
+//      slab around the road plane), sub-pixel disparity, triangulation to
+//      3D edge chains (edge_matching.h);
+//   4. road plane by RANSAC + least squares, edges near it (road_plane.h);
+//   5. long sides: polygonisation, accumulator, grouping (long_sides.h);
+//   6. bands: side pairs, band planes, Hough transversal sides, vertices and
+//      covariances (band_modeling.h).
+//
+// The rig height over the road is not in the survey: the road plane in the
+// body frame is first estimated on a few exposures spread over the survey
+// with a wide search volume around a nominal plane, then tracked (median of
+// the latest per-pair fits) while exposures are processed in time order.
+//
+// Frames: body (FRD) metres for every 3D output; image coordinates of the
+// outputs are pixels of the ORIGINAL (distorted) images, (0, 0) the centre
+// of the top-left pixel.
+#ifndef ZEBRAGEO_RECONSTRUCTION_RECONSTRUCTION_H_
+#define ZEBRAGEO_RECONSTRUCTION_RECONSTRUCTION_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "reconstruction/band_modeling.h"
+#include "reconstruction/edge_matching.h"
+#include "reconstruction/long_sides.h"
+#include "reconstruction/road_plane.h"
+#include "reconstruction/road_rectification.h"
+#include "reconstruction/subpixel_edges.h"
+#include "survey/results.h"
+#include "survey/rig.h"
+#include "survey/survey.h"
+
+namespace zebrageo {
+
+// The search volume of section 3.1: a slab around the road plane whose
+// half-thickness grows with the distance from the cameras (the tolerance
+// angle theta on the rig's attitude over the road).
+struct SearchVolumeOptions {
+  // Nominal road normal in the body frame, pointing down (body +z for a
+  // level vehicle). Only a starting point: the plane is estimated.
+  Eigen::Vector3d nominal_road_normal_body = Eigen::Vector3d::UnitZ();
+  // Nominal height of the cameras over the road along that normal, metres
+  // (roof-mounted mapping cameras: 2 to 3 m).
+  double nominal_camera_height_m = 2.3;
+  // Half-thickness of the slab while the plane is first estimated: covers
+  // the error of the nominal height.
+  double initial_slab_half_thickness_m = 1.0;
+  double initial_tolerance_angle_rad = 0.1;
+  // Exposures (spread over the survey) used for the first estimate.
+  int initialization_exposures = 8;
+  // Slab once the plane is known: half-thickness at the cameras, plus
+  // distance * tan(tolerance_angle_rad) (vehicle roll and pitch on its
+  // suspension, road camber).
+  double slab_half_thickness_m = 0.15;
+  double tolerance_angle_rad = 0.03;
+  // The running plane is the median of the last this-many per-pair fits.
+  int running_window = 15;
+  // Per-pair fits farther than this from the running plane (angle, offset)
+  // do not update it.
+  double max_plane_change_rad = 0.05;
+  double max_plane_change_m = 0.15;
+
+  std::string Check() const;
+};
+
+struct ReconstructionOptions {
+  RectificationOptions rectification;
+  EdgeOptions edges;
+  MatchingOptions matching;
+  SearchVolumeOptions search;
+  RoadPlaneOptions road_plane;
+  ZebraSpecification zebra;
+  LongSideOptions long_sides;
+  BandOptions bands;
+  // Worker threads over exposures; 0: one per hardware thread. The output
+  // does not depend on it.
+  int threads = 0;
+  // Exposures are processed in batches of this size, in time order; the
+  // running road plane is updated between batches (so results do not
+  // depend on the number of threads).
+  int batch_exposures = 16;
+  // When not empty, images with edges, candidates and final bands are
+  // written there for a person to check.
+  std::string debug_image_folder;
+  uint64_t seed = 1;  // RANSAC
+
+  std::string Check() const;
+};
+
+// Seconds spent in each step, summed over stereo pairs (CPU time of the
+// workers, not wall time).
+struct StepTimings {
+  double read_images_s = 0.0;
+  double rectify_s = 0.0;
+  double edges_s = 0.0;
+  double matching_s = 0.0;
+  double road_plane_s = 0.0;
+  double long_sides_s = 0.0;
+  double bands_s = 0.0;
+  double debug_images_s = 0.0;
+
+  double Total() const;
+  void Add(const StepTimings& other);
+  std::string Report() const;  // "rectify 12.3 ms, edges ..." per pair
+};
+
+// The result of one stereo pair.
+struct PairReconstruction {
+  bool road_plane_ok = false;
+  RoadPlane road_plane;  // body frame
+  std::vector<Band> bands;
+  int edge_points[2] = {0, 0};
+  int matches = 0;
+  int road_points = 0;
+  int long_sides = 0;
+  StepTimings timings;
+};
+
+// Everything the stages of one stereo pair need that does not change
+// between exposures: the cameras and the rectification tables.
+class StereoPairReconstructor {
+ public:
+  // `rectification_plane`: the road plane the rectified geometry is built
+  // for. Check ok() before use.
+  StereoPairReconstructor(const RigCamera& left, const RigCamera& right,
+                          const RoadPlane& rectification_plane,
+                          const ReconstructionOptions& options);
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  const RoadRectification& rectification() const { return rectification_; }
+
+  // Runs the pipeline on two original CV_32F images. `prior` is the
+  // expected road plane (the slab's centre), `slab_half_thickness_m` and
+  // `tolerance_angle_rad` the search volume. `stop_after_road_plane`: only
+  // estimate the plane (initialisation). `debug_prefix`: when not empty,
+  // debug images are written to debug_prefix + "_*.png".
+  PairReconstruction Reconstruct(const cv::Mat& left_image,
+                                 const cv::Mat& right_image,
+                                 const RoadPlane& prior,
+                                 double slab_half_thickness_m,
+                                 double tolerance_angle_rad, uint64_t seed,
+                                 bool stop_after_road_plane,
+                                 const std::string& debug_prefix) const;
+
+  // Pixel of a body point in the original (distorted) image of `side`.
+  bool ProjectToOriginal(int side, const Eigen::Vector3d& p_body,
+                         Eigen::Vector2d* uv) const;
+
+ private:
+  RigCamera cameras_[2];
+  ReconstructionOptions options_;
+  RoadRectification rectification_;
+  std::string error_;
+};
+
+struct ReconstructionSummary {
+  int exposures = 0;            // in the survey
+  int exposures_processed = 0;  // all their pairs ran
+  int exposures_skipped = 0;    // unreadable or missing images
+  int pairs_processed = 0;
+  int pairs_without_road = 0;  // no road plane found
+  int bands = 0;
+  int crossings = 0;             // distinct group_id
+  RoadPlane initial_road_plane;  // body frame, from the initialisation
+  RoadPlane final_road_plane;    // the running estimate at the end
+  StepTimings timings;           // summed over pairs
+  double wall_time_s = 0.0;
+  std::vector<std::string> warnings;
+  std::string message;  // why the result is unusable, or a one-line summary
+  bool usable = false;
+
+  bool IsUsable() const { return usable; }
+  std::string BriefReport() const;
+};
+
+// Progress: (exposures done, exposures total).
+using ProgressCallback = std::function<void(int, int)>;
+
+// Reconstructs the bands of every stereo pair of every exposure. Vertices
+// are appended to `vertices` in a deterministic order (exposures by time,
+// pairs in rig order, bands in order), band_id and group_id numbered from 1.
+ReconstructionSummary ReconstructSurvey(
+    const Survey& survey, const ReconstructionOptions& options,
+    std::vector<ReconstructedVertex>* vertices,
+    const ProgressCallback& progress = nullptr);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_RECONSTRUCTION_RECONSTRUCTION_H_

@@ -1,0 +1,52 @@
+// Robust road plane (Soheilian et al., section 4.2): RANSAC with a 20 cm
+// tolerance on the 3D edge points, then least squares on the points close
+// to it. Frames: body (FRD), metres; the normal points down (see RoadPlane).
+#ifndef ZEBRAGEO_RECONSTRUCTION_ROAD_PLANE_H_
+#define ZEBRAGEO_RECONSTRUCTION_ROAD_PLANE_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "reconstruction/road_rectification.h"
+
+namespace zebrageo {
+
+struct RoadPlaneOptions {
+  // RANSAC inlier distance to the plane (the paper's 20 cm).
+  double ransac_tolerance_m = 0.2;
+  int ransac_iterations = 300;
+  // After the least-squares refinement, points farther than this from the
+  // plane are not road (the paper filters at 20 cm as well).
+  double keep_distance_m = 0.2;
+  // Planes whose normal is farther than this from the expected normal are
+  // not the road (facades, car bodies).
+  double max_normal_deviation_rad = 0.25;
+  // Fewer inliers than this: no plane.
+  int min_inliers = 30;
+
+  std::string Check() const;
+};
+
+struct RoadPlaneFit {
+  bool ok = false;
+  RoadPlane plane;
+  std::vector<int> inliers;  // indices of the points within keep_distance_m
+  double rms_m = 0.0;        // of the inliers' distances
+};
+
+// Fits the road plane to `points`. `expected_normal` orients the normal
+// (down) and bounds its deviation. Deterministic for a given seed.
+RoadPlaneFit FitRoadPlane(const std::vector<Eigen::Vector3d>& points,
+                          const Eigen::Vector3d& expected_normal,
+                          const RoadPlaneOptions& options, uint64_t seed);
+
+// Least-squares plane through points (unit normal, oriented along
+// `orientation`); false for fewer than 3 points or collinear ones.
+bool FitPlaneLeastSquares(const std::vector<Eigen::Vector3d>& points,
+                          const Eigen::Vector3d& orientation, RoadPlane* plane);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_RECONSTRUCTION_ROAD_PLANE_H_

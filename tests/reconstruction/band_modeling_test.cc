@@ -1,0 +1,122 @@
+#include "reconstruction/band_modeling.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+namespace zebrageo {
+namespace {
+
+// A skewed band (a parallelogram) in a rectified image: long sides x = 70
+// and x = 103, transversal sides y = y0 + tan(skew) (x - 86.5) with y0 = 60
+// (begin, top) and 240 (end), bright paint on dark asphalt, blurred
+// along y by `blur_y` (far transversal sides are blurred along the road).
+constexpr double kSkew = 14.0 * M_PI / 180.0;
+
+double InsideBand(double x, double y) {
+  const double t = std::tan(kSkew) * (x - 86.5);
+  return x > 70.0 && x < 103.0 && y > 60.0 + t && y < 240.0 + t ? 1.0 : 0.0;
+}
+
+cv::Mat RenderBand(double blur_y) {
+  cv::Mat image(300, 170, CV_32F);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      double sum = 0.0;
+      for (int k = 0; k < 64; ++k) {
+        sum += InsideBand(x - 0.5 + (k % 8 + 0.5) / 8.0,
+                          y - 0.5 + (k / 8 + 0.5) / 8.0);
+      }
+      image.at<float>(y, x) = static_cast<float>(50.0 + 120.0 * sum / 64.0);
+    }
+  }
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.7, blur_y);
+  cv::Mat noise(image.size(), CV_32F);
+  cv::randn(noise, 0.0, 1.5);
+  return image + noise;
+}
+
+// The search area of section 5.1: between the long sides (inset), +-27 px
+// around the approximate (unskewed) transversal side y = y0.
+std::array<Eigen::Vector2d, 4> Area(double y0) {
+  return {Eigen::Vector2d(73, y0 - 27), Eigen::Vector2d(100, y0 - 27),
+          Eigen::Vector2d(100, y0 + 27), Eigen::Vector2d(73, y0 + 27)};
+}
+
+void ExpectSkewedSide(const ImageLine& line, double y0, double blur) {
+  // The true line: normal (-sin, cos) of the skew, through (86.5, y0).
+  const Eigen::Vector2d normal(-std::sin(kSkew), std::cos(kSkew));
+  const double angle = std::acos(std::abs(line.normal.dot(normal)));
+  // Blur along the road spreads the profile: 0.3 degrees for sharp sides,
+  // 0.6 for very blurred ones (0.15 px over the side's 30 px).
+  EXPECT_LT(angle, 0.15 * std::max(2.0, blur) * M_PI / 180.0);
+  EXPECT_LT(std::abs(line.Distance(Eigen::Vector2d(86.5, y0))), 0.1);
+}
+
+class HoughTransversal : public ::testing::TestWithParam<double> {};
+
+TEST_P(HoughTransversal, FindsTheSkewedSidesWithinATenthOfAPixel) {
+  const cv::Mat image = RenderBand(GetParam());
+  const EdgeMap edges = DetectSubpixelEdges(image, cv::Mat(), EdgeOptions());
+  BandOptions options;
+  const Eigen::Vector2d expected_normal(0.0, 1.0);  // unskewed guess
+  const std::vector<ImageLine> begin =
+      HoughTransversalCandidates(edges, Area(60.0), expected_normal, options);
+  // At the end the image darkens along +y: the expected polarity flips.
+  const std::vector<ImageLine> end =
+      HoughTransversalCandidates(edges, Area(240.0), -expected_normal, options);
+  ASSERT_FALSE(begin.empty());
+  ASSERT_FALSE(end.empty());
+  int t = -1, l = -1;
+  ASSERT_TRUE(ChooseTransversalPair(begin, end, Eigen::Vector2d(0, 1), options,
+                                    &t, &l));
+  ImageLine top = begin[t], bottom = end[l];
+  // Gammas are opposite: into the band at both ends.
+  EXPECT_GT(top.gamma.y(), 0.0);
+  EXPECT_LT(bottom.gamma.y(), 0.0);
+  ASSERT_TRUE(RefineImageLine(edges, Area(60.0), options, &top));
+  ASSERT_TRUE(RefineImageLine(edges, Area(240.0), options, &bottom));
+  ExpectSkewedSide(top, 60.0, GetParam());
+  ExpectSkewedSide(bottom, 240.0, GetParam());
+}
+
+// Sharp (near) and blurred along the road (far) transversal sides.
+INSTANTIATE_TEST_SUITE_P(Blur, HoughTransversal,
+                         ::testing::Values(0.7, 2.5, 4.0));
+
+TEST(HoughTransversal, PairChoiceRequiresPaintBetweenTheSides) {
+  ImageLine a, b;
+  a.gamma = Eigen::Vector2d(0, -50);  // darkens into the band: a gap
+  b.gamma = Eigen::Vector2d(0, 50);
+  int t, l;
+  EXPECT_FALSE(ChooseTransversalPair({a}, {b}, Eigen::Vector2d(0, 1),
+                                     BandOptions(), &t, &l));
+  EXPECT_TRUE(ChooseTransversalPair({b}, {a}, Eigen::Vector2d(0, 1),
+                                    BandOptions(), &t, &l));
+}
+
+TEST(HoughTransversal, PairChoiceTakesTheMostOppositeStrongPair) {
+  // Equations 2 and 3: among pairs scoring within 80 % of the best, the
+  // one with the smallest gamma dot product.
+  ImageLine b1, b2, e1, e2;
+  b1.gamma = Eigen::Vector2d(20, 90);  // strongest, but slanted
+  b2.gamma = Eigen::Vector2d(0, 85);
+  e1.gamma = Eigen::Vector2d(0, -88);
+  e2.gamma = Eigen::Vector2d(0, -30);  // weak: out of the 80 %
+  int t, l;
+  ASSERT_TRUE(ChooseTransversalPair({b1, b2}, {e1, e2}, Eigen::Vector2d(0, 1),
+                                    BandOptions(), &t, &l));
+  EXPECT_EQ(t, 0);  // (0*0 + 90*-88) < (0 + 85*-88)
+  EXPECT_EQ(l, 0);
+}
+
+TEST(BandOptions, CheckNamesTheBadField) {
+  BandOptions options;
+  options.hough_score_fraction = 1.5;
+  EXPECT_EQ(options.Check(), "hough_score_fraction = 1.5: must be in (0, 1]");
+}
+
+}  // namespace
+}  // namespace zebrageo

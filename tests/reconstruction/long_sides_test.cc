@@ -1,0 +1,133 @@
+#include "reconstruction/long_sides.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace zebrageo {
+namespace {
+
+Segment2d Segment(double lateral, double from, double to) {
+  Segment2d s;
+  s.a = Eigen::Vector2d(lateral, from);  // direction +y, lateral along x
+  s.b = Eigen::Vector2d(lateral, to);
+  return s;
+}
+
+TEST(LongSides, DouglasPeuckerKeepsTheCornerOfAnL) {
+  std::vector<Eigen::Vector2d> polyline;
+  for (int i = 0; i <= 10; ++i) polyline.emplace_back(0.1 * i, 0.001 * (i % 2));
+  for (int i = 1; i <= 10; ++i) polyline.emplace_back(1.0, 0.1 * i);
+  EXPECT_EQ(DouglasPeucker(polyline, 0.02), (std::vector<int>{0, 10, 20}));
+}
+
+TEST(LongSides, AccumulatorPairsLinesOneBandWidthApart) {
+  // A 4-band crossing (edges at 0, 0.5, ..., 3.5 m), its sides broken in
+  // pieces; a lane line (two edges 0.15 m apart) at 5 m; manhole-cover
+  // clutter at 7 m.
+  std::vector<Segment2d> segments;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (int edge = 0; edge < 8; ++edge) {
+    for (double from = 0.0; from < 3.0; from += 0.6) {
+      segments.push_back(Segment(0.5 * edge + noise(rng), from, from + 0.5));
+    }
+  }
+  segments.push_back(Segment(5.0, 0.0, 3.0));
+  segments.push_back(Segment(5.15, 0.0, 3.0));
+  segments.push_back(Segment(7.0, 0.0, 0.6));
+  const std::vector<AccumulatorComponent> components = ParallelLineComponents(
+      segments, Eigen::Vector2d(0, 1), ZebraSpecification(), LongSideOptions());
+  // With direction +y, the lateral axis is (-1, 0): laterals are -x.
+  int paired = 0;
+  for (const AccumulatorComponent& c : components) {
+    const double x = -c.lateral_m;
+    if (x < 3.7) {
+      EXPECT_TRUE(c.paired) << x;
+      EXPECT_NEAR(x, 0.5 * std::round(x / 0.5), 0.01);
+      ++paired;
+    } else {
+      EXPECT_FALSE(c.paired) << x;  // the lane line, the clutter
+    }
+  }
+  EXPECT_EQ(paired, 8);
+}
+
+TEST(LongSides, PrincipalDirectionIsTheMostFrequentOne) {
+  std::vector<Segment2d> segments;
+  for (int i = 0; i < 10; ++i) {
+    Segment2d s;
+    s.a = Eigen::Vector2d(i, 0);
+    s.b = s.a + Eigen::Vector2d(std::cos(0.3), std::sin(0.3));
+    segments.push_back(s);
+  }
+  Segment2d other;
+  other.b = Eigen::Vector2d(0, 3);
+  segments.push_back(other);
+  double weight = 0.0;
+  const Eigen::Vector2d d = PrincipalDirection(segments, 0.17, &weight);
+  EXPECT_NEAR(std::atan2(d.y(), d.x()), 0.3, 0.005);
+  EXPECT_NEAR(weight, 10.0, 1e-9);
+}
+
+// 3D chains of a 3-band crossing on the plane z = 1 (body), bands along x;
+// one side of the middle band is broken by a 0.6 m occlusion.
+std::vector<EdgeChain3d> CrossingChains() {
+  std::vector<EdgeChain3d> chains;
+  std::mt19937 rng(2);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  for (int edge = 0; edge < 6; ++edge) {
+    const double y = 0.5 * edge;  // band k: [y_2k, y_2k+1] bright
+    const double gradient = edge % 2 == 0 ? 1.0 : -1.0;  // along +y
+    std::vector<std::pair<double, double>> pieces = {{5.0, 8.0}};
+    if (edge == 2) pieces = {{5.0, 6.0}, {6.6, 8.0}};
+    for (const auto& [from, to] : pieces) {
+      EdgeChain3d chain;
+      for (double x = from; x <= to; x += 0.01) {
+        EdgePoint3d p;
+        p.p_body = Eigen::Vector3d(x, y + noise(rng), 1.0 + noise(rng));
+        // The plane frame's e1 is the body y axis (see the test).
+        p.gradient = Eigen::Vector2d(30.0 * gradient, 0.0);
+        chain.points.push_back(p);
+      }
+      chains.push_back(chain);
+    }
+  }
+  return chains;
+}
+
+TEST(LongSides, DetectsEverySideAndBridgesTheOcclusion) {
+  RoadPlane road;
+  road.offset_m = 1.0;
+  const PlaneFrame frame =
+      PlaneFrame::Make(road, Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero());
+  const LongSideDetection detection = DetectLongSides(
+      CrossingChains(), frame, ZebraSpecification(), LongSideOptions());
+  ASSERT_EQ(detection.sides.size(), 6u);
+  for (const LongSide& side : detection.sides) {
+    EXPECT_NEAR(side.Length(), 3.0, 0.02);  // the broken one too
+    EXPECT_LT(std::abs(side.direction_body.x()), 1.0);
+    EXPECT_NEAR(std::abs(side.direction_body.x()), 1.0, 1e-3);
+    EXPECT_LT(side.lateral_rms_m, 0.004);
+    // Brighter towards +y on even edges.
+    const double y = side.point_body.y();
+    const int edge = static_cast<int>(std::lround(y / 0.5));
+    const double towards_plus_y =
+        side.contrast * frame.Direction3d(side.Normal2d()).y();
+    EXPECT_EQ(towards_plus_y > 0.0, edge % 2 == 0) << y;
+  }
+}
+
+TEST(LongSides, CheckNamesTheBadField) {
+  LongSideOptions options;
+  options.min_long_side_length_m = 0.0;
+  EXPECT_EQ(options.Check(), "min_long_side_length_m = 0: must be > 0");
+  ZebraSpecification zebra;
+  zebra.max_band_length_m = 1.0;
+  EXPECT_EQ(zebra.Check(),
+            "max_band_length_m = 1: must be >= min_band_length_m");
+}
+
+}  // namespace
+}  // namespace zebrageo

@@ -1,0 +1,275 @@
+// End to end: a small simulated survey (SimulateSurvey) reconstructed and
+// scored against its truth like ../shared/tools/score_results.py does
+// (reconstruct mode), in the body frame with the true trajectory.
+#include "reconstruction/reconstruction.h"
+
+#include <glog/logging.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <set>
+
+#include "survey/roadmarks.h"
+#include "survey/trajectory.h"
+#include "tools/simulator/simulator.h"
+
+namespace zebrageo {
+namespace {
+
+struct Score {
+  int visible = 0;
+  int detected = 0;
+  int reported = 0;
+  int false_bands = 0;
+  int correct = 0;  // all 4 vertices within 3 cm
+  double sum_squares_close = 0.0;
+  int vertices_close = 0;  // within 10 m of the left camera
+  double Detection() const { return detected / std::max(1.0, 1.0 * visible); }
+  double Correct() const {
+    return correct / std::max(1.0, 1.0 * (reported - false_bands));
+  }
+  double RmseClose() const {
+    return std::sqrt(sum_squares_close / std::max(1, vertices_close));
+  }
+};
+
+class SmallSurvey : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    folder_ = new std::string(
+        (std::filesystem::temp_directory_path() /
+         ("zebrageo-reconstruction-test-" + std::to_string(::getpid())))
+            .string());
+    SimulationOptions options;
+    ASSERT_EQ(ApplyPreset("demo", &options), "");
+    options.seed = 7;
+    options.road_length_m = 45.0;
+    options.num_crossings = 1;
+    options.num_stale_crossings = 0;
+    options.min_crossing_spacing_m = 20.0;
+    options.exposure_spacing_m = 3.0;
+    options.parked_vehicles_per_100m = 8.0;  // distractors
+    ASSERT_EQ(options.Check(), "");
+    SimulateSurvey(options, *folder_, nullptr);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ignored;
+    std::filesystem::remove_all(*folder_, ignored);
+    delete folder_;
+  }
+
+  // Scores `vertices` against the truth of the survey.
+  static Score ScoreAgainstTruth(
+      const Survey& survey, const std::vector<ReconstructedVertex>& vertices) {
+    const Trajectory truth(
+        ReadTrajectorySamples(survey.PathOf("truth/trajectory.csv"), "truth"),
+        survey.frame);
+    const RoadmarkDatabase bands =
+        ReadRoadmarks(survey.PathOf("truth/roadmarks.geojson"), "truth");
+    std::vector<std::array<Eigen::Vector3d, 4>> corners_enu;
+    for (const RoadmarkBand& band : bands.bands) {
+      std::array<Eigen::Vector3d, 4> c;
+      for (int k = 0; k < 4; ++k) {
+        c[k] = survey.frame.EnuFromGeodetic(band.corners[k]);
+      }
+      corners_enu.push_back(c);
+    }
+    const Rig& rig = survey.rig;
+    std::map<int64_t, std::vector<const ReconstructedVertex*>> by_band;
+    for (const ReconstructedVertex& v : vertices)
+      by_band[v.band_id].push_back(&v);
+    Score score;
+    std::map<int64_t, std::set<int>> found;  // exposure -> truth bands
+    for (const auto& [id, band] : by_band) {
+      EXPECT_EQ(band.size(), 4u);
+      const int64_t exposure_id = band[0]->exposure_id;
+      double time = 0.0;
+      for (const Exposure& e : survey.exposures.exposures) {
+        if (e.exposure_id == exposure_id) time = e.time;
+      }
+      Pose pose;
+      CHECK(truth.InterpolatePose(time, &pose));
+      const Eigen::Isometry3d T_body_enu = pose.T_enu_body().inverse();
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const auto* v : band) centre += v->p_body / 4.0;
+      int best = -1;
+      double best_distance = 1e9;
+      for (size_t b = 0; b < corners_enu.size(); ++b) {
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3d& p : corners_enu[b])
+          c += T_body_enu * p / 4.0;
+        if ((c - centre).norm() < best_distance) {
+          best_distance = (c - centre).norm();
+          best = static_cast<int>(b);
+        }
+      }
+      ++score.reported;
+      if (best_distance > 0.3) {
+        ++score.false_bands;
+        continue;
+      }
+      found[exposure_id].insert(best);
+      const Eigen::Vector3d left_centre =
+          rig.cameras[rig.stereo_pairs[band[0]->pair][0]]
+              .T_body_cam.translation();
+      bool all_close = true;
+      for (const auto* v : band) {
+        double error = 1e9;
+        for (const Eigen::Vector3d& p : corners_enu[best]) {
+          error = std::min(error, (T_body_enu * p - v->p_body).norm());
+        }
+        all_close = all_close && error < 0.03;
+        if ((centre - left_centre).norm() <= 10.0) {
+          score.sum_squares_close += error * error;
+          ++score.vertices_close;
+        }
+      }
+      score.correct += all_close;
+    }
+    // Visible: all corners inside both images (5 px margin), centre within
+    // 15 m of the left camera.
+    for (const Exposure& e : survey.exposures.exposures) {
+      Pose pose;
+      CHECK(truth.InterpolatePose(e.time, &pose));
+      const Eigen::Isometry3d T_body_enu = pose.T_enu_body().inverse();
+      for (size_t b = 0; b < corners_enu.size(); ++b) {
+        bool visible = true;
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3d& p : corners_enu[b]) {
+          centre += T_body_enu * p / 4.0;
+        }
+        for (int c : rig.stereo_pairs[0]) {
+          const RigCamera& camera = rig.cameras[c];
+          for (const Eigen::Vector3d& p : corners_enu[b]) {
+            const Eigen::Vector3d p_cam =
+                camera.T_body_cam.inverse() * (T_body_enu * p);
+            Eigen::Vector2d uv;
+            visible = visible && p_cam.z() > 0.5 &&
+                      camera.camera.Project(p_cam, &uv) && uv.x() >= 5 &&
+                      uv.y() >= 5 && uv.x() <= camera.camera.width() - 5 &&
+                      uv.y() <= camera.camera.height() - 5;
+          }
+        }
+        const Eigen::Vector3d left_centre =
+            rig.cameras[rig.stereo_pairs[0][0]].T_body_cam.translation();
+        if (!visible || (centre - left_centre).norm() > 15.0) continue;
+        ++score.visible;
+        score.detected += found[e.exposure_id].count(static_cast<int>(b));
+      }
+    }
+    return score;
+  }
+
+  static std::string* folder_;
+};
+
+std::string* SmallSurvey::folder_ = nullptr;
+
+// The checks below share one simulated survey (simulating is most of the
+// time): gtest_discover_tests runs each TEST in its own process.
+void OutputDoesNotDependOnTheNumberOfThreads(const std::string& folder) {
+  SurveyLoadOptions load;
+  load.load_roadmarks = false;
+  Survey survey = LoadSurvey(folder, load);
+  // A third of the exposures is enough.
+  survey.exposures.exposures.resize(survey.exposures.exposures.size() / 3);
+  std::vector<ReconstructedVertex> one, two;
+  ReconstructionOptions options;
+  options.threads = 1;
+  ReconstructSurvey(survey, options, &one);
+  options.threads = 2;
+  ReconstructSurvey(survey, options, &two);
+  ASSERT_EQ(one.size(), two.size());
+  for (size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].band_id, two[k].band_id);
+    EXPECT_EQ(one[k].p_body, two[k].p_body);
+  }
+}
+
+void UnreadableImageSkipsItsExposureWithAWarning(const std::string& folder) {
+  SurveyLoadOptions load;
+  load.load_roadmarks = false;
+  Survey survey = LoadSurvey(folder, load);
+  survey.exposures.exposures.resize(3);
+  // Point the first exposure's left image at a file that is not an image.
+  const std::string broken = folder + "/broken.png";
+  { std::ofstream(broken) << "not a png"; }
+  survey.exposures.images[survey.exposures.exposures[0].image_of_camera[0]]
+      .image = "broken.png";
+  std::vector<ReconstructedVertex> vertices;
+  const ReconstructionSummary summary =
+      ReconstructSurvey(survey, ReconstructionOptions(), &vertices);
+  ASSERT_TRUE(summary.IsUsable()) << summary.message;
+  EXPECT_EQ(summary.exposures_skipped, 1);
+  EXPECT_EQ(summary.exposures_processed, 2);
+  bool warned = false;
+  for (const std::string& w : summary.warnings) {
+    warned = warned || w.find("broken.png") != std::string::npos;
+  }
+  EXPECT_TRUE(warned);
+}
+
+TEST_F(SmallSurvey, ReconstructsTheVisibleBandsToTheCentimetre) {
+  SurveyLoadOptions load;
+  load.load_roadmarks = false;
+  const Survey survey = LoadSurvey(*folder_, load);
+  ReconstructionOptions options;
+  options.threads = 2;
+  std::vector<ReconstructedVertex> vertices;
+  int calls = 0;
+  const ReconstructionSummary summary =
+      ReconstructSurvey(survey, options, &vertices, [&](int done, int total) {
+        ++calls;
+        EXPECT_LE(done, total);
+      });
+  ASSERT_TRUE(summary.IsUsable()) << summary.message;
+  EXPECT_EQ(calls, summary.exposures);
+  EXPECT_EQ(summary.exposures_skipped, 0);
+  // The road is 1 m below the IMU (simulator's imu_height_m).
+  EXPECT_NEAR(summary.final_road_plane.offset_m, 1.0, 0.05);
+  const Score score = ScoreAgainstTruth(survey, vertices);
+  LOG(INFO) << "detection " << score.detected << "/" << score.visible
+            << ", all-4-within-3cm " << score.Correct() << ", RMSE (<= 10 m) "
+            << score.RmseClose() << " m over " << score.vertices_close
+            << " vertices, false bands " << score.false_bands;
+  EXPECT_GE(score.visible, 20);
+  EXPECT_GE(score.Detection(), 0.85);
+  EXPECT_GE(score.Correct(), 0.9);
+  EXPECT_LT(score.RmseClose(), 0.02);
+  EXPECT_GE(score.vertices_close, 24);
+  EXPECT_LE(score.false_bands, 1);
+  // Covariances are symmetric positive definite, scores in (0, 1].
+  for (const ReconstructedVertex& v : vertices) {
+    EXPECT_LT((v.covariance_body - v.covariance_body.transpose()).norm(),
+              1e-15);
+    EXPECT_GT(v.covariance_body.determinant(), 0.0);
+    EXPECT_GT(v.score, 0.0);
+    EXPECT_LE(v.score, 1.0);
+  }
+  {
+    SCOPED_TRACE("threads");
+    OutputDoesNotDependOnTheNumberOfThreads(*folder_);
+  }
+  {
+    SCOPED_TRACE("unreadable image");
+    UnreadableImageSkipsItsExposureWithAWarning(*folder_);
+  }
+}
+
+TEST(ReconstructionOptions, CheckNamesTheBadNestedField) {
+  ReconstructionOptions options;
+  EXPECT_EQ(options.Check(), "");
+  options.search.slab_half_thickness_m = 0.0;
+  EXPECT_EQ(options.Check(), "slab_half_thickness_m = 0: must be > 0");
+  options = ReconstructionOptions();
+  options.threads = -2;
+  EXPECT_EQ(options.Check(), "threads = -2: must be >= 0");
+}
+
+}  // namespace
+}  // namespace zebrageo
