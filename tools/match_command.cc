@@ -1,18 +1,67 @@
-// `zebrageo match SURVEY -o RESULTS`.
+// `zebrageo match SURVEY -o RESULTS`: reads RESULTS/reconstructed_bands.csv,
+// writes matches.csv, crossing_decisions.csv, match_evidence.json and
+// matches.geojson (registration/match_stage.h).
+#include <glog/logging.h>
+
+#include <iostream>
 #include <memory>
 
+#include "registration/match_stage.h"
+#include "survey/survey.h"
 #include "tools/commands.h"
+#include "tools/exit_codes.h"
+#include "tools/progress.h"
 
 namespace zebrageo {
 
 void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
   auto args = std::make_shared<StageArguments>();
+  auto options = std::make_shared<MatchOptions>();
   CLI::App* sub = AddStageSubcommand(
       app, "match",
       "Match reconstructed bands to the road-mark database; writes "
-      "matches.csv and crossing_decisions.csv.",
+      "matches.csv, crossing_decisions.csv, match_evidence.json and "
+      "matches.geojson.",
       args.get());
-  commands->push_back({sub, NotImplementedStage(args, "match", "issue 6")});
+  sub->add_option("--max-drift-m", options->max_drift_m,
+                  "horizontal trajectory error the search allows (m)")
+      ->capture_default_str();
+  sub->add_option("--max-heading-error-rad", options->max_heading_error_rad,
+                  "heading error the search allows (rad)")
+      ->capture_default_str();
+  sub->add_option("--min-margin", options->min_margin,
+                  "score margin over the best alternative needed to match")
+      ->capture_default_str();
+  sub->add_option("--missing-band-weight", options->missing_band_weight,
+                  "score penalty of a database band the cameras should have "
+                  "seen but did not")
+      ->capture_default_str();
+  sub->add_option("--vertex-tolerance-m", options->vertex_tolerance_m,
+                  "largest corner residual of a matched band (m)")
+      ->capture_default_str();
+  sub->add_option("--drift-rate-m-per-s", options->drift_rate_m_per_s,
+                  "how fast the trajectory error may change (m/s)")
+      ->capture_default_str();
+  sub->add_flag("--require-both-ends", options->require_both_ends,
+                "resolve the band period only when both ends of a crossing "
+                "agree (immune to a database fault at one end)");
+  sub->add_flag("--refuse-shifted-crossings", options->refuse_shifted_crossings,
+                "refuse matches to database crossings that look shifted");
+  commands->push_back({sub, [args, options] {
+                         const std::string problem = options->Check();
+                         if (!problem.empty()) {
+                           throw UsageError("match: " + problem);
+                         }
+                         const Survey survey = LoadSurvey(args->survey);
+                         ProgressBar bar("match");
+                         const MatchResult result = RunMatchStage(
+                             survey, args->results, *options, bar.Callback());
+                         bar.Finish();
+                         if (!result.summary.IsUsable()) {
+                           throw StageFailedError(result.summary.message);
+                         }
+                         std::cout << result.summary.BriefReport() << "\n";
+                       }});
 }
 
 }  // namespace zebrageo

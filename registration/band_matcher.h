@@ -1,0 +1,314 @@
+// Matching reconstructed zebra bands to the road-mark database: which
+// database band vertex each reconstructed vertex is, so that it can serve as
+// a ground control point.
+//
+// Frames and units: `body` is the vehicle frame (FRD) at an exposure, `enu`
+// the survey's working frame; metres, radians, seconds. Poses are survey
+// Poses: p_enu = q_enu_body * p_body + p_enu (Eigen quaternions, Hamilton).
+//
+// Model. The measured trajectory is wrong by a slowly varying drift of up to
+// metres. At one exposure its horizontal error is a PoseCorrection: a
+// heading error about the vertical through the vehicle and a horizontal
+// shift,
+//   p_true = Rz(heading_rad) * (p_measured - p_vehicle) + p_vehicle + shift,
+// with p_measured = q_enu_body * p_body + p_enu placed with the measured
+// pose. Height is left to the adjustment (a zebra is flat).
+//
+// Method (details in band_matcher.cc):
+//  1. Hypotheses. For each observation (the bands of one reconstructed
+//     crossing group in one exposure) every pairing of an observed band with
+//     a database band of compatible shape inside the drift gate gives a
+//     correction; it is refined on all the bands it explains and scored:
+//     +1 per band explained to `hit_tolerance_m` at all four corners,
+//     -missing_band_weight per database band of an explained crossing that
+//     the cameras would have seen whole but that was not observed,
+//     -contradiction_weight per observed band lying in a gap of a database
+//     crossing, -unexplained_band_weight per band outside every crossing.
+//  2. Aggregation. The drift changes slowly, so observations within
+//     `window_s` share the correction: a hypothesis is scored by the sum over
+//     those observations of their own hypothesis at the same correction.
+//  3. Decision. The best hypothesis must beat every distinct alternative
+//     (another band offset, another crossing) by `min_margin`; with
+//     `require_both_ends`, even without the evidence of the crossing end
+//     that favours it most (a band missing on either side at that end must
+//     not decide the 1 m periodicity).
+//  4. Continuity. Crossings matched alone must imply consistent corrections
+//     (within neighbour_tolerance_m + drift_rate_m_per_s * time apart);
+//     outliers are refused, and observations ambiguous alone are resolved
+//     when the correction interpolated from matched neighbours singles out
+//     one hypothesis.
+//  5. Database faults are detected and reported: crossings missing from the
+//     database, crossings gone from the street, bands missing on either
+//     side, crossings shifted (repainted) by decimetres.
+#ifndef ZEBRAGEO_REGISTRATION_BAND_MATCHER_H_
+#define ZEBRAGEO_REGISTRATION_BAND_MATCHER_H_
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "registration/roadmark_index.h"
+#include "survey/results.h"
+#include "survey/rig.h"
+#include "survey/trajectory.h"
+
+namespace zebrageo {
+
+struct MatchOptions {
+  // --- Candidate gating -------------------------------------------------
+  // Horizontal error of the measured trajectory the search allows. The
+  // GNSS/INS sd_* are often optimistic by an order of magnitude in urban
+  // canyons: raise this for long outages, lower it to speed up clean data.
+  double max_drift_m = 4.0;
+  // The gate also covers this many times the trajectory's claimed
+  // horizontal sd, when that is larger than max_drift_m.
+  double sd_gate_factor = 5.0;
+  // Heading error of the measured trajectory the search allows (2 degrees).
+  double max_heading_error_rad = 0.035;
+
+  // --- Band shape -------------------------------------------------------
+  // Observed bands outside these sizes are not zebra bands (lane marks,
+  // stop lines, truncated bands) and are not used to hypothesise.
+  double min_band_length_m = 1.5;
+  double max_band_length_m = 8.0;
+  double min_band_width_m = 0.25;
+  double max_band_width_m = 0.9;
+  // An observed band pairs with a database band only if the sizes agree.
+  double max_length_difference_m = 0.6;
+  double max_width_difference_m = 0.2;
+
+  // --- Scoring ----------------------------------------------------------
+  // A band is explained ("hit") when its four corners, after the
+  // correction, lie within this of a database band's corners. Well below
+  // half the 1 m band period, above database error + drift change.
+  double hit_tolerance_m = 0.3;
+  // A vertex becomes a control point only if, after the correction refined
+  // on the observation's own bands, every corner of its band lies within
+  // this of its database corner.
+  double vertex_tolerance_m = 0.15;
+  double missing_band_weight = 1.0;
+  // Over the window, a database band that should have been seen counts as
+  // missing in at most this many views, and not at all if it was seen in
+  // another: a vehicle parked at the kerb hides a band from many views at
+  // once, and views of one place are not independent.
+  int max_missing_views = 2;
+  double contradiction_weight = 2.0;
+  double unexplained_band_weight = 0.5;
+  // Visibility of database bands (for missing-band evidence): a band counts
+  // as "should have been seen" only when all its corners project at least
+  // this far inside both images of a stereo pair...
+  // 0: learn it from the data: the 1st percentile of how close to the image
+  // border the observed bands come, plus visibility_safety_px.
+  double visibility_margin_px = 0.0;
+  double visibility_safety_px = 20.0;
+  // ... and its centre lies within this horizontal range of the vehicle.
+  // 0: take the 90th percentile of the observed bands' ranges.
+  double visibility_range_m = 0.0;
+
+  // --- Aggregation over time --------------------------------------------
+  // Observations within +-window_s of each other share one correction.
+  double window_s = 3.0;
+  // Two hypotheses are the same correction when they place the observed
+  // bands within this of each other (plus the drift change over the time
+  // between them).
+  double same_correction_tolerance_m = 0.2;
+  // How fast the trajectory error may change (metres per second): an INS
+  // drifting 3 m in a minute-long outage changes by ~0.05 m/s.
+  double drift_rate_m_per_s = 0.05;
+
+  // --- Decision ---------------------------------------------------------
+  // Bands an observation must explain itself to be matched.
+  int min_hit_bands = 2;
+  // Aggregated score by which the best hypothesis must beat the best
+  // distinct one (in band-equivalents: 2 = two exposures that see what lies
+  // beyond an end of the crossing).
+  double min_margin = 2.0;
+  // The 1 m periodicity is resolved at the crossing's ends. A database
+  // fault at one end (its end band missing on either side) makes the
+  // evidence of that end point one band off. true: require the margin even
+  // without the evidence of the stronger end, i.e. both ends must agree
+  // (immune to one end fault, but a crossing whose far end is never in view
+  // is then matched only through continuity). false: one end decides and
+  // the continuity check between crossings is the safety net.
+  bool require_both_ends = false;
+
+  // --- Continuity between crossings -------------------------------------
+  // Matched crossings within this time of each other must agree.
+  double neighbour_window_s = 30.0;
+  // Allowed disagreement at zero time apart (database error, noise), plus
+  // max_drift_rate_m_per_s per second apart: a worst case, not a typical
+  // rate, since refusing a good crossing costs as much as a wrong one here.
+  double neighbour_tolerance_m = 0.35;
+  double max_drift_rate_m_per_s = 0.1;
+  // Neighbours whose allowed disagreement exceeds this cannot tell a
+  // one-band error from drift and do not vote.
+  double max_informative_tolerance_m = 0.8;
+  // Ambiguous observations are resolved from neighbours only when the
+  // bound on the predicted correction's error is below max_resolve_bound_m
+  // (well below half the 1 m band period), and no GNSS event (the claimed
+  // sd changing by more than max_sd_ratio) lies between them. The bound is
+  // resolve_base_m plus, extrapolating from one side, drift_rate_m_per_s *
+  // time to the match, or, interpolating between matches at tb and ta,
+  // max_drift_acceleration_m_per_s2 * (t - tb) * (ta - t) / 2 (an INS
+  // drift is smooth: 1 m of error varying over a minute accelerates by
+  // ~0.01 m/s^2).
+  double resolve_base_m = 0.1;
+  double max_drift_acceleration_m_per_s2 = 0.01;
+  double max_resolve_bound_m = 0.35;
+  double max_sd_ratio = 2.0;
+
+  // --- Database faults --------------------------------------------------
+  // A matched crossing whose correction departs from its neighbours' by
+  // more than this is reported as shifted (repainted).
+  double shifted_crossing_threshold_m = 0.15;
+  // Refuse matches to crossings reported as shifted (they would bias the
+  // adjustment by the shift).
+  bool refuse_shifted_crossings = false;
+  // Views needed before a crossing or band is reported missing or gone.
+  int min_views_for_fault = 3;
+
+  // "" or the first invalid field, e.g. "max_drift_m = -1: must be > 0".
+  std::string Check() const;
+};
+
+// A horizontal correction of the measured pose at one exposure (see the
+// header comment): p_true = Rz(heading_rad) (p - p_vehicle) + p_vehicle +
+// shift_enu_m.
+struct PoseCorrection {
+  double heading_rad = 0.0;
+  Eigen::Vector2d shift_enu_m = Eigen::Vector2d::Zero();
+};
+
+// One reconstructed band of an observation.
+struct ObservedBand {
+  int64_t band_id = 0;
+  int pair = 0;  // stereo pair index
+  // The vertex labels as written (column `vertex`) and the positions.
+  std::array<int, 4> vertex = {0, 1, 2, 3};
+  std::array<Eigen::Vector3d, 4> p_body;
+  double score = 1.0;
+};
+
+// The bands of one reconstructed crossing group seen in one exposure.
+struct CrossingObservation {
+  int64_t exposure_id = 0;
+  int64_t group_id = 0;
+  double time_s = 0.0;
+  Pose pose;                     // measured T_enu_body at time_s
+  double sd_horizontal_m = 0.0;  // the trajectory's claimed sd (max of e, n)
+  std::vector<ObservedBand> bands;
+};
+
+// Every exposure of the survey (also those where nothing was seen: a
+// crossing gone from the street is recognised by what was NOT observed).
+struct ExposurePose {
+  int64_t exposure_id = 0;
+  double time_s = 0.0;
+  Pose pose;  // measured
+};
+
+struct MatchInput {
+  std::vector<CrossingObservation> observations;
+  std::vector<ExposurePose> exposures;
+  const RoadmarkIndex* index = nullptr;  // required
+  // Cameras for visibility reasoning; nullptr: no missing-band evidence
+  // (fewer matches, never wrong ones).
+  const Rig* rig = nullptr;
+};
+
+enum class FaultKind {
+  kCrossingMissingFromDatabase,
+  kCrossingGoneFromStreet,
+  kBandMissingFromStreet,
+  kBandMissingFromDatabase,
+  kCrossingShifted,
+};
+const char* FaultKindName(FaultKind kind);  // e.g. "crossing_gone_from_street"
+
+struct DatabaseFault {
+  FaultKind kind = FaultKind::kCrossingGoneFromStreet;
+  std::string crossing_id;  // empty for a crossing missing from the database
+  int band = 0;             // band faults: the band (or the one beyond)
+  Eigen::Vector2d location_enu = Eigen::Vector2d::Zero();
+  double shift_m = 0.0;  // kCrossingShifted
+  int views = 0;         // exposures behind the finding
+  std::vector<int64_t> exposure_ids;
+  std::string description;
+};
+
+// Why one observation was decided as it was.
+struct ObservationEvidence {
+  int64_t exposure_id = 0;
+  int64_t group_id = 0;
+  double time_s = 0.0;
+  Decision decision = Decision::kNoCandidate;
+  std::string crossing_id;
+  std::string reason;
+  int bands = 0;         // observed bands
+  int usable_bands = 0;  // with a zebra band's shape and 4 vertices
+  int candidate_db_bands = 0;
+  int hypotheses = 0;
+  // Of the chosen (or best) hypothesis, in this observation alone:
+  int hits = 0;
+  int missing = 0;
+  int contradictions = 0;
+  int unexplained = 0;
+  double own_score = 0.0;
+  // Over the window:
+  double aggregated_score = 0.0;
+  bool has_runner_up = false;
+  double runner_up_score = 0.0;
+  double robust_margin = 0.0;     // the margin the decision used
+  double both_ends_margin = 0.0;  // without the stronger end's evidence
+  std::string runner_up;  // what the runner-up is ("band offset +1", ...)
+  bool resolved_by_neighbours = false;
+  PoseCorrection correction;
+  double vertex_rms_m = 0.0;
+  int vertex_matches = 0;
+  std::vector<int> matched_bands;  // database band numbers
+};
+
+struct MatchSummary {
+  int observations = 0;
+  int matched = 0;
+  int refused = 0;
+  int no_candidate = 0;
+  int ambiguous = 0;               // refused as ambiguous
+  int inconsistent = 0;            // refused by the continuity check
+  int resolved_by_neighbours = 0;  // matched thanks to continuity
+  int vertex_matches = 0;
+  int crossings_matched = 0;
+  int faults = 0;
+  double seconds = 0.0;
+  // Empty when the matcher ran; otherwise why not (bad options, no index).
+  std::string message;
+
+  bool IsUsable() const { return message.empty(); }
+  std::string BriefReport() const;
+};
+
+struct MatchResult {
+  std::vector<VertexMatch> matches;
+  std::vector<CrossingDecision> decisions;    // one per observation, in order
+  std::vector<ObservationEvidence> evidence;  // one per observation, in order
+  std::vector<DatabaseFault> faults;
+  MatchSummary summary;
+};
+
+// Matches every observation. Deterministic. `progress` (may be empty) is
+// called with (done, total) observations.
+MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
+                       const std::function<void(int, int)>& progress = {});
+
+// The ENU position of a body-frame point under a measured pose corrected by
+// `correction` (horizontal only).
+Eigen::Vector3d CorrectedEnu(const Pose& measured,
+                             const PoseCorrection& correction,
+                             const Eigen::Vector3d& p_body);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_REGISTRATION_BAND_MATCHER_H_

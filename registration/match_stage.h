@@ -1,0 +1,61 @@
+// The match stage on a survey and its results folder (SURVEY_FORMAT.md,
+// "Stage outputs"): reads RESULTS/reconstructed_bands.csv, matches the bands
+// to the survey's road-mark database (band_matcher.h) and writes
+//   matches.csv             reconstructed vertex <-> database vertex
+//   crossing_decisions.csv  one row per (exposure, group): matched, refused
+//                           or no_candidate, and why
+//   match_evidence.json     the evidence behind each decision, the database
+//                           faults found, the options and the summary
+//   matches.geojson         for QGIS: each matched vertex as a line from its
+//                           measured placement to its database corner, the
+//                           matched bands placed with the estimated
+//                           correction, and the database faults as points
+// Every file is written atomically.
+#ifndef ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_
+#define ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "registration/band_matcher.h"
+#include "registration/roadmark_index.h"
+#include "survey/results.h"
+#include "survey/survey.h"
+
+namespace zebrageo {
+
+inline constexpr char kMatchEvidenceFile[] = "match_evidence.json";
+inline constexpr char kMatchesGeoJsonFile[] = "matches.geojson";
+
+// Groups reconstructed vertices into observations (one per exposure and
+// group), with the measured pose at each exposure. Bands with fewer than 4
+// vertices cannot be matched vertex by vertex: they are left out and
+// counted in `incomplete_bands` (may be null). Throws InputError naming
+// `display_name` for an exposure_id the survey does not have or a pair index
+// the rig does not have.
+std::vector<CrossingObservation> BuildObservations(
+    const Survey& survey, const std::vector<ReconstructedVertex>& vertices,
+    const std::string& display_name, int* incomplete_bands);
+
+// The measured pose of every exposure of the survey.
+std::vector<ExposurePose> ExposurePoses(const Survey& survey);
+
+// Writers (atomic).
+void WriteMatchEvidence(const MatchResult& result, const MatchOptions& options,
+                        const std::vector<std::string>& warnings,
+                        const LocalFrame& frame, const std::string& path);
+void WriteMatchesGeoJson(const MatchInput& input, const MatchResult& result,
+                         const LocalFrame& frame, const std::string& path);
+
+// The whole stage. Throws InputError for unreadable or inconsistent
+// inputs (a missing reconstructed_bands.csv included). The result's summary
+// says whether the matcher ran (IsUsable).
+MatchResult RunMatchStage(const Survey& survey,
+                          const std::string& results_folder,
+                          const MatchOptions& options,
+                          const std::function<void(int, int)>& progress = {});
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_

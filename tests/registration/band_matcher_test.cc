@@ -1,0 +1,305 @@
+#include "registration/band_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "tests/registration/synthetic_scene.h"
+
+namespace zebrageo {
+namespace {
+
+// Runs the matcher on a scene and scores it against the scene's truth.
+struct SceneRun {
+  SyntheticScene scene;
+  RoadmarkIndex index;
+  MatchResult result;
+  MatchScore score;
+};
+
+SceneRun MatchScene(const SyntheticSceneOptions& scene_options,
+                    const MatchOptions& options = MatchOptions()) {
+  SceneRun run;
+  run.scene = MakeSyntheticScene(scene_options);
+  run.index = RoadmarkIndex(run.scene.database, run.scene.frame);
+  run.result = MatchBands(run.scene.Input(run.index), options);
+  run.score = ScoreMatches(run.scene, run.result.matches);
+  return run;
+}
+
+bool Contains(const std::vector<std::string>& list, const std::string& x) {
+  return std::find(list.begin(), list.end(), x) != list.end();
+}
+
+int CountDecisions(const MatchResult& result, Decision decision,
+                   const std::string& reason_part = "") {
+  int n = 0;
+  for (const CrossingDecision& d : result.decisions) {
+    if (d.decision == decision &&
+        d.reason.find(reason_part) != std::string::npos) {
+      ++n;
+    }
+  }
+  return n;
+}
+
+bool HasFault(const MatchResult& result, FaultKind kind,
+              const std::string& crossing_id, int band = 0) {
+  for (const DatabaseFault& fault : result.faults) {
+    if (fault.kind == kind && fault.crossing_id == crossing_id &&
+        (band == 0 || fault.band == band)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+double MatchedShare(const MatchScore& score) {
+  return score.crossings_eligible.empty()
+             ? 1.0
+             : static_cast<double>(score.crossings_matched.size()) /
+                   score.crossings_eligible.size();
+}
+
+SyntheticSceneOptions Street(int seed, int crossings = 8,
+                             double spacing_m = 45.0) {
+  SyntheticSceneOptions options;
+  options.seed = seed;
+  options.crossings = RandomCrossings(crossings, spacing_m, seed);
+  return options;
+}
+
+TEST(MatchOptions, CheckNamesTheFieldItsValueAndTheConstraint) {
+  EXPECT_EQ(MatchOptions().Check(), "");
+  MatchOptions options;
+  options.max_drift_m = -1.0;
+  EXPECT_EQ(options.Check(), "max_drift_m = -1: must be > 0");
+  options = MatchOptions();
+  options.hit_tolerance_m = 0.6;
+  EXPECT_NE(options.Check().find("hit_tolerance_m = 0.6: must be < 0.5"),
+            std::string::npos);
+  options = MatchOptions();
+  options.min_hit_bands = 0;
+  EXPECT_EQ(options.Check(), "min_hit_bands = 0: must be >= 1");
+}
+
+TEST(BandMatcher, ReportsInvalidOptionsInsteadOfRunning) {
+  MatchOptions options;
+  options.window_s = -2.0;
+  const RoadmarkIndex index;
+  MatchInput input;
+  input.index = &index;
+  const MatchResult result = MatchBands(input, options);
+  EXPECT_FALSE(result.summary.IsUsable());
+  EXPECT_EQ(result.summary.message,
+            "MatchOptions: window_s = -2: must be >= 0");
+  EXPECT_TRUE(result.matches.empty());
+}
+
+TEST(BandMatcher, MatchesAStreetWithTwoMetresOfDriftWithoutAWrongVertex) {
+  for (int seed = 1; seed <= 3; ++seed) {
+    const SceneRun run = MatchScene(Street(seed));
+    SCOPED_TRACE("seed " + std::to_string(seed) + ": " +
+                 run.result.summary.BriefReport());
+    EXPECT_EQ(run.score.wrong, 0);
+    EXPECT_GT(run.score.right, 100);
+    EXPECT_GE(MatchedShare(run.score), 0.95);
+    EXPECT_EQ(run.result.decisions.size(), run.scene.observations.size());
+  }
+}
+
+TEST(BandMatcher, RecoversTwoMetreDriftDespiteOneMetrePeriod) {
+  // The drift is two band periods straight across the crossings: a nearest-
+  // band match would be off by two bands everywhere.
+  SyntheticSceneOptions options = Street(4);
+  options.drift_m = 0.0;
+  options.constant_shift_m = Eigen::Vector2d(0.03, 2.0);
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_GE(MatchedShare(run.score), 0.95);
+  for (const ObservationEvidence& e : run.result.evidence) {
+    if (e.decision != Decision::kMatched) continue;
+    EXPECT_NEAR(e.correction.shift_enu_m.y(), -2.0, 0.15);
+  }
+}
+
+TEST(BandMatcher, RecoversThreeMetreDriftOfAnOutage) {
+  SyntheticSceneOptions options = Street(5);
+  options.drift_m = 3.0;
+  options.heading_drift_rad = 0.01;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_GE(MatchedShare(run.score), 0.95);
+}
+
+TEST(BandMatcher, NeverGuessesWhenTheDriftOutrunsContinuity) {
+  // 3 m of drift turning at 0.09 m/s: too fast to carry a correction from
+  // one crossing to the next 5 s later. Crossings seen end to end still
+  // match; the others are refused, none is guessed.
+  for (int seed = 5; seed <= 7; ++seed) {
+    SyntheticSceneOptions options = Street(seed);
+    options.drift_m = 3.0;
+    options.drift_turn_rate_rad_per_s = 0.03;
+    options.heading_drift_rad = 0.01;
+    const SceneRun run = MatchScene(options);
+    SCOPED_TRACE(run.result.summary.BriefReport());
+    EXPECT_EQ(run.score.wrong, 0);
+    EXPECT_GE(MatchedShare(run.score), 0.5);
+  }
+}
+
+TEST(BandMatcher, RefusesWhenOnlyInteriorBandsAreSeen) {
+  // One wide crossing, a narrow field of view: the ends are never in view,
+  // so the band offset cannot be told.
+  SyntheticSceneOptions options;
+  options.seed = 6;
+  SyntheticCrossingSpec wide;
+  wide.x_m = 0.0;
+  wide.bands = 12;
+  wide.band_length_m = 3.0;
+  options.crossings = {wide};
+  options.road_y0_m = -8.0;
+  options.lane_y_m = -2.0;
+  options.horizontal_fov_deg = 35.0;
+  options.max_range_m = 9.0;
+  options.false_band_probability = 0.0;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_TRUE(run.result.matches.empty());
+  EXPECT_GT(CountDecisions(run.result, Decision::kRefused, "ambiguous"), 0);
+  EXPECT_GT(CountDecisions(run.result, Decision::kRefused,
+                           "only interior bands seen"),
+            0);
+  EXPECT_GT(run.result.summary.ambiguous, 0);
+}
+
+TEST(BandMatcher, ResolvesInteriorViewsFromAMatchedNeighbourCrossing) {
+  // A narrow crossing seen whole, then 34 m on (beyond the +-3 s window) a
+  // wide one seen only inside:
+  // the correction carried over from the first singles out the offset.
+  SyntheticSceneOptions options;
+  options.seed = 7;
+  SyntheticCrossingSpec narrow;
+  narrow.x_m = 0.0;
+  narrow.bands = 4;
+  narrow.y0_m = -4.0;
+  SyntheticCrossingSpec wide;
+  wide.x_m = 34.0;
+  wide.bands = 12;
+  wide.y0_m = -8.0;
+  options.crossings = {narrow, wide};
+  options.lane_y_m = -2.0;
+  options.horizontal_fov_deg = 60.0;
+  options.max_range_m = 12.0;
+  options.false_band_probability = 0.0;
+  options.drift_turn_rate_rad_per_s = 0.0;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_TRUE(Contains(run.score.crossings_matched, "C01"));
+  EXPECT_TRUE(Contains(run.score.crossings_matched, "C02"));
+  EXPECT_GT(run.result.summary.resolved_by_neighbours, 0);
+  EXPECT_GT(CountDecisions(run.result, Decision::kMatched,
+                           "resolved by trajectory continuity"),
+            0);
+}
+
+TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
+  // The database has crossing C03 one band period off (a wrong survey): it
+  // still fits perfectly alone, but implies a correction 1 m away from the
+  // crossings before and after it.
+  SyntheticSceneOptions options = Street(8, 5, 30.0);
+  options.crossings[2].database_shift_m = Eigen::Vector2d(0.0, 1.0);
+  options.drift_turn_rate_rad_per_s = 0.0;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_FALSE(Contains(run.score.crossings_matched, "C03"));
+  EXPECT_GT(CountDecisions(run.result, Decision::kRefused, "inconsistent"), 0);
+  EXPECT_TRUE(Contains(run.score.crossings_matched, "C02"));
+  EXPECT_TRUE(Contains(run.score.crossings_matched, "C04"));
+}
+
+TEST(BandMatcher, ReportsCrossingGoneFromTheStreet) {
+  SyntheticSceneOptions options = Street(9, 5);
+  options.crossings[2].in_street = false;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_TRUE(HasFault(run.result, FaultKind::kCrossingGoneFromStreet, "C03"));
+  for (const std::string id : {"C01", "C02", "C04", "C05"}) {
+    EXPECT_FALSE(HasFault(run.result, FaultKind::kCrossingGoneFromStreet, id))
+        << id;
+  }
+}
+
+TEST(BandMatcher, ReportsCrossingMissingFromTheDatabase) {
+  SyntheticSceneOptions options = Street(10, 5);
+  options.crossings[1].in_database = false;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_GE(MatchedShare(run.score), 0.95);
+  EXPECT_GT(CountDecisions(run.result, Decision::kNoCandidate,
+                           "missing from the database"),
+            0);
+  int missing = 0;
+  for (const DatabaseFault& fault : run.result.faults) {
+    missing += fault.kind == FaultKind::kCrossingMissingFromDatabase;
+  }
+  EXPECT_EQ(missing, 1);
+}
+
+TEST(BandMatcher, ReportsBandsMissingOnEitherSideWithoutGuessing) {
+  SyntheticSceneOptions options = Street(11, 6);
+  for (SyntheticCrossingSpec& c : options.crossings) c.bands = 6;
+  options.crossings[1].street_lacks = {options.crossings[1].bands};
+  options.crossings[3].database_lacks = {1};
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_TRUE(
+      HasFault(run.result, FaultKind::kBandMissingFromStreet, "C02", 6));
+}
+
+TEST(BandMatcher, ReportsARepaintedCrossingShiftedByDecimetres) {
+  SyntheticSceneOptions options = Street(12, 5);
+  options.crossings[2].database_shift_m = Eigen::Vector2d(0.35, 0.0);
+  options.drift_turn_rate_rad_per_s = 0.0;
+  options.database_offset_m = 0.02;
+  const SceneRun run = MatchScene(options);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+  EXPECT_TRUE(HasFault(run.result, FaultKind::kCrossingShifted, "C03"));
+  EXPECT_FALSE(HasFault(run.result, FaultKind::kCrossingShifted, "C02"));
+}
+
+TEST(BandMatcher, MapsVerticesToDatabaseCornersWhateverTheRingOrder) {
+  const SceneRun run = MatchScene(Street(13, 3));
+  ASSERT_FALSE(run.result.matches.empty());
+  std::set<int> db_vertices;
+  std::set<int> vertices;
+  for (const VertexMatch& m : run.result.matches) {
+    db_vertices.insert(m.db_vertex);
+    vertices.insert(m.vertex);
+  }
+  EXPECT_EQ(db_vertices.size(), 4u);
+  EXPECT_EQ(vertices.size(), 4u);
+  EXPECT_EQ(run.score.wrong, 0);
+}
+
+TEST(BandMatcher, IsDeterministic) {
+  const SceneRun a = MatchScene(Street(14, 3));
+  const SceneRun b = MatchScene(Street(14, 3));
+  ASSERT_EQ(a.result.matches.size(), b.result.matches.size());
+  for (size_t i = 0; i < a.result.matches.size(); ++i) {
+    EXPECT_EQ(a.result.matches[i].band_id, b.result.matches[i].band_id);
+    EXPECT_EQ(a.result.matches[i].db_vertex, b.result.matches[i].db_vertex);
+  }
+}
+
+}  // namespace
+}  // namespace zebrageo
