@@ -1,0 +1,76 @@
+// What `zebrageo adjust` reads and writes (SURVEY_FORMAT.md "Outputs").
+//
+// Reads the survey without requiring its images (a geometry-only survey is
+// adjustable; images only feed the tie points), plus RESULTS/
+// reconstructed_bands.csv and RESULTS/matches.csv. Writes, each atomically:
+//   trajectory_corrected.csv  the input's columns and times, corrected
+//   poses.csv                 one row per exposures.csv row
+//   gcp_residuals.csv         the contract's columns, then status
+//                             (control|check|rejected) and
+//                             normalized_residual
+//   bands.geojson             reconstructed bands placed with the corrected
+//                             trajectory
+//   adjustment.json           the adjustment's part of report.json
+//   report.json               a minimal report with the same figures (the
+//                             report stage replaces it with the full one)
+//   colmap/cameras.txt, images.txt, points3D.txt
+//                             COLMAP text model of the adjusted cameras:
+//                             world = the survey's ENU frame, one
+//                             FULL_OPENCV camera per rig camera (COLMAP's
+//                             pixel centres are at +0.5: cx, cy and the 2D
+//                             points are shifted by 0.5), points = control
+//                             and tie points with their tracks.
+#ifndef ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_IO_H_
+#define ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_IO_H_
+
+#include <string>
+#include <vector>
+
+#include "adjustment/tie_points.h"
+#include "adjustment/trajectory_adjuster.h"
+#include "survey/survey.h"
+
+namespace zebrageo {
+
+inline constexpr char kAdjustmentJsonFile[] = "adjustment.json";
+inline constexpr char kColmapFolder[] = "colmap";
+
+struct AdjustmentData {
+  std::string survey_folder;
+  SurveyManifest manifest;
+  Rig rig;
+  LocalFrame frame{Geodetic{}};
+  Trajectory trajectory;
+  ExposureTable exposures;
+  RoadmarkDatabase roadmarks;
+  std::vector<ReconstructedVertex> vertices;
+  std::vector<VertexMatch> matches;
+  // Images named in exposures.csv that are not on disk.
+  int missing_images = 0;
+  std::vector<std::string> warnings;
+
+  AdjustmentInput Input() const;
+};
+
+// Throws InputError: any survey file the readers reject, exposures outside
+// the trajectory, a missing or malformed reconstructed_bands.csv or
+// matches.csv (the message says which stage to run first).
+AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
+                                  const std::string& results_folder);
+
+// Writes every output listed above into `results_folder` (created if
+// needed). `tie_summary` may be null (no tie points). Throws
+// std::runtime_error when a file cannot be written.
+void WriteAdjustmentResults(const AdjustmentData& data,
+                            const AdjustmentOptions& options,
+                            const AdjustmentResult& result,
+                            const TiePointSummary* tie_summary,
+                            const std::string& results_folder);
+
+// Writes the gcp_residuals.csv rows of `points` to `path`.
+void WriteGcpResidualsWithStatus(const std::vector<ControlPointResult>& points,
+                                 const std::string& path);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_IO_H_

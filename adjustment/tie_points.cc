@@ -1,0 +1,325 @@
+#include "adjustment/tie_points.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <numeric>
+#include <opencv2/features2d.hpp>
+#include <sstream>
+
+#include "survey/image_io.h"
+
+namespace zebrageo {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr float kOrbScaleFactor = 1.2f;
+
+struct ImageFeatures {
+  bool valid = false;
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  std::vector<Eigen::Vector2d> normalized;  // undistorted x/z, y/z
+  std::vector<char> has_normalized;
+  Eigen::Isometry3d T_enu_cam = Eigen::Isometry3d::Identity();
+};
+
+// Union-find over (image, keypoint) nodes.
+class DisjointSets {
+ public:
+  int Add() {
+    parent_.push_back(static_cast<int>(parent_.size()));
+    return parent_.back();
+  }
+  int Find(int x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void Union(int a, int b) { parent_[Find(a)] = Find(b); }
+
+ private:
+  std::vector<int> parent_;
+};
+
+// Epipolar distance (pixels in image b) of a correspondence between images
+// a and b with known poses.
+double EpipolarDistancePx(const ImageFeatures& a, const ImageFeatures& b,
+                          const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
+                          double focal_b) {
+  const Eigen::Isometry3d T_b_a = b.T_enu_cam.inverse() * a.T_enu_cam;
+  const Eigen::Vector3d t = T_b_a.translation();
+  Eigen::Matrix3d tx;
+  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  const Eigen::Matrix3d E = tx * T_b_a.linear();
+  const Eigen::Vector3d line = E * xa.homogeneous();
+  const double norm = line.head<2>().norm();
+  if (norm <= 0.0) return HUGE_VAL;
+  return std::abs(line.dot(xb.homogeneous())) / norm * focal_b;
+}
+
+}  // namespace
+
+std::string TiePointOptions::Check() const {
+  std::ostringstream message;
+  if (max_features_per_image < 10) {
+    message << "max_features_per_image = " << max_features_per_image
+            << ": must be >= 10";
+  } else if (!(max_descriptor_ratio > 0.0 && max_descriptor_ratio <= 1.0)) {
+    message << "max_descriptor_ratio = " << max_descriptor_ratio
+            << ": must be in (0, 1]";
+  } else if (!(max_epipolar_distance_px > 0.0)) {
+    message << "max_epipolar_distance_px = " << max_epipolar_distance_px
+            << ": must be > 0";
+  } else if (exposure_window < 1) {
+    message << "exposure_window = " << exposure_window << ": must be >= 1";
+  } else if (!(max_reprojection_error_px > 0.0)) {
+    message << "max_reprojection_error_px = " << max_reprojection_error_px
+            << ": must be > 0";
+  } else if (!(max_range_m > 2.0)) {
+    message << "max_range_m = " << max_range_m << ": must be > 2";
+  } else if (!(min_triangulation_angle_deg >= 0.0)) {
+    message << "min_triangulation_angle_deg = " << min_triangulation_angle_deg
+            << ": must be >= 0";
+  } else if (min_track_length < 2) {
+    message << "min_track_length = " << min_track_length << ": must be >= 2";
+  } else if (max_tracks_per_exposure < 1) {
+    message << "max_tracks_per_exposure = " << max_tracks_per_exposure
+            << ": must be >= 1";
+  }
+  return message.str();
+}
+
+std::vector<TieTrack> BuildTieTracks(
+    const TiePointOptions& options, const std::string& survey_folder,
+    const Rig& rig, const Trajectory& trajectory,
+    const ExposureTable& exposures, TiePointSummary* summary,
+    const std::function<void(int, int)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  CHECK(summary != nullptr);
+  *summary = TiePointSummary();
+  const std::string error = options.Check();
+  CHECK(error.empty()) << "TiePointOptions: " << error;
+
+  const int num_images = static_cast<int>(exposures.images.size());
+  std::vector<ImageFeatures> features(num_images);
+  std::vector<int> node_offset(num_images, 0);
+  DisjointSets sets;
+  std::vector<std::pair<int, int>> node_key;  // node -> (image, keypoint)
+  cv::Ptr<cv::ORB> orb = cv::ORB::create(options.max_features_per_image,
+                                         kOrbScaleFactor, options.orb_levels);
+  cv::BFMatcher matcher(cv::NORM_HAMMING);
+
+  auto load = [&](int image_index) {
+    ImageFeatures& f = features[image_index];
+    const ExposureImage& image = exposures.images[image_index];
+    const std::string path =
+        (std::filesystem::path(survey_folder) / image.image).string();
+    Pose pose;
+    if (!trajectory.InterpolatePose(image.time, &pose)) return;
+    cv::Mat grey;
+    try {
+      const cv::Mat f32 = ReadGrayImage(path, image.image);
+      f32.convertTo(grey, CV_8U);
+    } catch (const std::exception&) {
+      ++summary->images_missing;
+      return;
+    }
+    ++summary->images_read;
+    orb->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
+    // ORB reports a keypoint found on pyramid level l at x_l * s; with
+    // pixel centres at integers (cv::resize) it is at (x_l + 0.5) s - 0.5.
+    for (cv::KeyPoint& kp : f.keypoints) {
+      const double scale = std::pow(kOrbScaleFactor, kp.octave);
+      kp.pt.x += static_cast<float>(0.5 * (scale - 1.0));
+      kp.pt.y += static_cast<float>(0.5 * (scale - 1.0));
+    }
+    const Camera& camera = rig.cameras[image.camera].camera;
+    f.normalized.resize(f.keypoints.size());
+    f.has_normalized.assign(f.keypoints.size(), 0);
+    for (size_t k = 0; k < f.keypoints.size(); ++k) {
+      const Eigen::Vector2d uv(f.keypoints[k].pt.x, f.keypoints[k].pt.y);
+      f.has_normalized[k] = camera.UnprojectToNormalized(uv, &f.normalized[k]);
+    }
+    f.T_enu_cam = pose.T_enu_body() * rig.cameras[image.camera].T_body_cam;
+    f.valid = !f.keypoints.empty();
+    node_offset[image_index] = static_cast<int>(node_key.size());
+    for (size_t k = 0; k < f.keypoints.size(); ++k) {
+      sets.Add();
+      node_key.emplace_back(image_index, static_cast<int>(k));
+    }
+  };
+
+  auto match = [&](int a, int b) {
+    const ImageFeatures& fa = features[a];
+    const ImageFeatures& fb = features[b];
+    if (!fa.valid || !fb.valid) return;
+    std::vector<std::vector<cv::DMatch>> knn;
+    matcher.knnMatch(fa.descriptors, fb.descriptors, knn, 2);
+    const double focal = rig.cameras[exposures.images[b].camera].camera.fx();
+    for (const auto& m : knn) {
+      if (m.size() < 2 ||
+          m[0].distance > options.max_descriptor_ratio * m[1].distance) {
+        continue;
+      }
+      const int ka = m[0].queryIdx, kb = m[0].trainIdx;
+      if (!fa.has_normalized[ka] || !fb.has_normalized[kb]) continue;
+      if (EpipolarDistancePx(fa, fb, fa.normalized[ka], fb.normalized[kb],
+                             focal) > options.max_epipolar_distance_px) {
+        continue;
+      }
+      sets.Union(node_offset[a] + ka, node_offset[b] + kb);
+      ++summary->matches;
+    }
+  };
+
+  const int num_exposures = static_cast<int>(exposures.exposures.size());
+  for (int e = 0; e < num_exposures; ++e) {
+    const Exposure& exposure = exposures.exposures[e];
+    for (int image : exposure.image_of_camera) {
+      if (image >= 0) load(image);
+    }
+    for (const auto& pair : rig.stereo_pairs) {
+      const int a = exposure.image_of_camera[pair[0]];
+      const int b = exposure.image_of_camera[pair[1]];
+      if (a >= 0 && b >= 0) match(a, b);
+    }
+    for (int back = 1; back <= options.exposure_window && e - back >= 0;
+         ++back) {
+      const Exposure& previous = exposures.exposures[e - back];
+      for (size_t c = 0; c < rig.cameras.size(); ++c) {
+        const int a = previous.image_of_camera[c];
+        const int b = exposure.image_of_camera[c];
+        if (a >= 0 && b >= 0) match(a, b);
+      }
+    }
+    // Descriptors of exposures out of the window are no longer needed.
+    if (e - options.exposure_window >= 0) {
+      for (int image :
+           exposures.exposures[e - options.exposure_window].image_of_camera) {
+        if (image >= 0) features[image].descriptors.release();
+      }
+    }
+    if (progress) progress(e + 1, num_exposures);
+  }
+
+  // Tracks: connected components, at most one keypoint per image.
+  std::map<int, std::vector<int>> components;
+  for (int node = 0; node < static_cast<int>(node_key.size()); ++node) {
+    components[sets.Find(node)].push_back(node);
+  }
+  struct Candidate {
+    TieTrack track;
+    std::vector<int> exposures;
+  };
+  std::vector<Candidate> candidates;
+  std::map<int64_t, int> exposure_index;
+  for (int e = 0; e < num_exposures; ++e) {
+    exposure_index[exposures.exposures[e].exposure_id] = e;
+  }
+  const double min_angle = options.min_triangulation_angle_deg * kPi / 180.0;
+  for (const auto& [root, nodes] : components) {
+    if (static_cast<int>(nodes.size()) < options.min_track_length) continue;
+    std::vector<int> images;
+    bool conflict = false;
+    for (int node : nodes) images.push_back(node_key[node].first);
+    std::sort(images.begin(), images.end());
+    conflict = std::adjacent_find(images.begin(), images.end()) != images.end();
+    if (conflict) continue;
+    // Midpoint triangulation of the rays.
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    std::vector<Eigen::Vector3d> directions;
+    for (int node : nodes) {
+      const auto [image, k] = node_key[node];
+      const ImageFeatures& f = features[image];
+      const Eigen::Vector3d d =
+          (f.T_enu_cam.linear() * f.normalized[k].homogeneous()).normalized();
+      const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+      A += P;
+      b += P * f.T_enu_cam.translation();
+      directions.push_back(d);
+    }
+    const Eigen::Vector3d X = A.ldlt().solve(b);
+    if (!X.allFinite()) continue;
+    double max_angle = 0.0;
+    for (size_t i = 0; i < directions.size(); ++i) {
+      for (size_t j = i + 1; j < directions.size(); ++j) {
+        max_angle = std::max(
+            max_angle,
+            std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
+      }
+    }
+    if (max_angle < min_angle) continue;
+    Candidate candidate;
+    bool good = true;
+    for (int node : nodes) {
+      const auto [image, k] = node_key[node];
+      const ImageFeatures& f = features[image];
+      const ExposureImage& info = exposures.images[image];
+      const Eigen::Vector3d p_cam = f.T_enu_cam.inverse() * X;
+      Eigen::Vector2d uv;
+      const Eigen::Vector2d observed(f.keypoints[k].pt.x, f.keypoints[k].pt.y);
+      if (p_cam.z() < 2.0 || p_cam.norm() > options.max_range_m ||
+          !rig.cameras[info.camera].camera.Project(p_cam, &uv) ||
+          (uv - observed).norm() > options.max_reprojection_error_px) {
+        good = false;
+        break;
+      }
+      candidate.track.observations.push_back(
+          {image, info.time, info.camera, observed});
+      candidate.exposures.push_back(exposure_index[info.exposure_id]);
+    }
+    if (!good) continue;
+    candidate.track.p_enu = X;
+    std::sort(candidate.exposures.begin(), candidate.exposures.end());
+    candidate.exposures.erase(
+        std::unique(candidate.exposures.begin(), candidate.exposures.end()),
+        candidate.exposures.end());
+    if (candidate.exposures.size() < 2) continue;  // ties exposures together
+    // A stereo observation fixes the depth: a temporal mismatch on a
+    // repeated pattern (windows, bands) that slides along the epipolar line
+    // cannot agree with it.
+    if (options.require_stereo) {
+      std::map<int, int> cameras_in_exposure;
+      bool stereo = false;
+      for (const TieObservation& o : candidate.track.observations) {
+        const int e = exposure_index[exposures.images[o.image].exposure_id];
+        stereo |= ++cameras_in_exposure[e] >= 2;
+      }
+      if (!stereo) continue;
+    }
+    candidates.push_back(std::move(candidate));
+  }
+  // The longest tracks first, until every exposure has enough.
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) {
+              return a.track.observations.size() > b.track.observations.size();
+            });
+  std::vector<int> kept_per_exposure(num_exposures, 0);
+  std::vector<TieTrack> tracks;
+  for (Candidate& c : candidates) {
+    bool useful = false;
+    for (int e : c.exposures) {
+      useful |= kept_per_exposure[e] < options.max_tracks_per_exposure;
+    }
+    if (!useful) continue;
+    for (int e : c.exposures) ++kept_per_exposure[e];
+    summary->observations += static_cast<int>(c.track.observations.size());
+    tracks.push_back(std::move(c.track));
+  }
+  summary->tracks = static_cast<int>(tracks.size());
+  summary->time_in_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  LOG(INFO) << "tie points: " << summary->tracks << " tracks, "
+            << summary->observations << " observations from "
+            << summary->images_read << " images in " << summary->time_in_seconds
+            << " s";
+  return tracks;
+}
+
+}  // namespace zebrageo

@@ -1,0 +1,87 @@
+// Tie points: image features matched between the two images of each stereo
+// pair and between consecutive exposures (OpenCV ORB), chained into tracks,
+// triangulated with the INS poses and cleaned of outliers. In the
+// adjustment their reprojection errors tie the exposures together where
+// there is no control.
+//
+// Frames: tracks are triangulated in the survey's ENU frame; observations
+// are distorted pixel coordinates (pixel (0,0) = centre of the top-left
+// pixel), as the vertex observations.
+#ifndef ZEBRAGEO_ADJUSTMENT_TIE_POINTS_H_
+#define ZEBRAGEO_ADJUSTMENT_TIE_POINTS_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "survey/exposures.h"
+#include "survey/rig.h"
+#include "survey/trajectory.h"
+
+namespace zebrageo {
+
+struct TieObservation {
+  int image = 0;  // index into ExposureTable::images
+  double time = 0.0;
+  int camera = 0;  // index into Rig::cameras
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+};
+
+struct TieTrack {
+  std::vector<TieObservation> observations;         // at most one per image
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();  // triangulated
+};
+
+struct TiePointOptions {
+  // ORB features detected per image.
+  int max_features_per_image = 1500;
+  // ORB pyramid levels (scale 1.2 each): few, because a coarse level
+  // localises a corner to a fraction of its pixel, i.e. several pixels.
+  int orb_levels = 4;
+  // Lowe's ratio test on the two nearest descriptors.
+  double max_descriptor_ratio = 0.8;
+  // Matches are kept when the epipolar distance implied by the INS relative
+  // pose is below this (pixels; the INS is accurate over a fraction of a
+  // second, so this is a tight geometric check).
+  double max_epipolar_distance_px = 2.0;
+  // Consecutive exposures matched with each exposure (1 = the next one).
+  int exposure_window = 2;
+  // Triangulated tracks are kept when every reprojection error is below
+  // this (pixels), the point is 2 to max_range_m in front of each camera
+  // and the largest intersection angle exceeds min_triangulation_angle_deg.
+  double max_reprojection_error_px = 1.5;
+  double max_range_m = 40.0;
+  double min_triangulation_angle_deg = 2.0;
+  int min_track_length = 4;
+  // Keep only tracks seen by both cameras of a stereo pair at least once.
+  bool require_stereo = true;
+  // Tracks kept per exposure (the longest first): enough to tie, few
+  // enough to keep the adjustment fast.
+  int max_tracks_per_exposure = 25;
+
+  std::string Check() const;
+};
+
+struct TiePointSummary {
+  int images_read = 0;
+  int images_missing = 0;
+  int matches = 0;
+  int tracks = 0;
+  int observations = 0;
+  double time_in_seconds = 0.0;
+};
+
+// Builds tie-point tracks from the survey's images. Images that cannot be
+// read are skipped (counted in the summary). `progress(done, total)` is
+// called after each exposure when set.
+std::vector<TieTrack> BuildTieTracks(
+    const TiePointOptions& options, const std::string& survey_folder,
+    const Rig& rig, const Trajectory& trajectory,
+    const ExposureTable& exposures, TiePointSummary* summary,
+    const std::function<void(int, int)>& progress = nullptr);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_ADJUSTMENT_TIE_POINTS_H_

@@ -1,0 +1,251 @@
+// The trajectory adjustment (issue 7): a bundle adjustment that corrects the
+// drifting GNSS/INS trajectory with matched zebra-band vertices as ground
+// control points and image tie points.
+//
+// Unknowns: the trajectory correction (trajectory_correction.h: cubic
+// B-spline of [dtheta, dp] in ENU, knots every knot_spacing_s), one 3D point
+// (ENU) per control vertex and per tie track, one systematic offset (ENU)
+// per database crossing, and optionally each camera's mounting correction
+// (boresight rotation, lever arm).
+// Observations (all whitened, see cost_functions.h):
+//   - reprojection of control vertices (uv_left/uv_right of
+//     reconstructed_bands.csv), sigma vertex_sigma_px, Huber loss;
+//   - reprojection of tie points, sigma tie_sigma_px, Huber loss;
+//   - the database position of each control vertex (sigma_xy, sigma_z of
+//     the database) plus its crossing's offset (crossing_offset_sigma_m),
+//     Cauchy loss;
+//   - the GNSS/INS solution: the correction at each knot is 0 +- gnss_*
+//     (Cauchy loss: a GNSS jump is an outlier, not a constraint);
+//   - the INS relative motion: the drift rate (first difference of knots)
+//     and its change (second difference) are small; their sigmas set how
+//     fast the correction may vary between control points.
+// Solved with Ceres (SPARSE_SCHUR on SuiteSparse: points eliminated, the
+// banded knot system factorised), first without robust losses to take out
+// the drift, then robustly; then control vertices whose image-only position
+// disagrees with the database (normalised residual above
+// blunder_threshold) are removed and the adjustment repeated. A share of
+// crossings is held out as check points: evaluated, never adjusted.
+#ifndef ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
+#define ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "adjustment/solver_options.h"
+#include "adjustment/tie_points.h"
+#include "adjustment/trajectory_correction.h"
+#include "survey/exposures.h"
+#include "survey/geodesy.h"
+#include "survey/results.h"
+#include "survey/rig.h"
+#include "survey/roadmarks.h"
+#include "survey/trajectory.h"
+
+namespace zebrageo {
+
+struct AdjustmentOptions {
+  // ---------------------------------------------------- trajectory model
+  // Spacing of the B-spline knots. Shorter follows faster drift (GNSS
+  // jumps) but needs more control per second; 0.5-2 s suits drifts with
+  // periods of a minute.
+  double knot_spacing_s = 1.0;
+  // Express the correction in the track frame (along-track, cross-track,
+  // up: dead-reckoning errors turn with the vehicle) or in ENU.
+  bool track_frame = true;
+  // The GNSS/INS absolute position, per knot: realistic, not the file's
+  // optimistic sd_* (urban drift reaches metres). Cauchy loss of scale
+  // gnss_loss_scale (in sigmas).
+  double gnss_sigma_horizontal_m = 1.0;
+  double gnss_sigma_vertical_m = 1.0;
+  double gnss_loss_scale = 1.0;
+  // The INS absolute attitude, per knot (heading and tilt drift of a
+  // tactical-grade INS: a few hundredths of a degree to a tenth).
+  double ins_attitude_sigma_deg = 0.2;
+  // Drift rate: how fast the position/attitude error may change (first
+  // difference of knots / spacing), per knot interval.
+  double drift_rate_sigma_mps = 0.2;
+  double drift_rate_sigma_deg_per_s = 0.02;
+  // Change of the drift rate (second difference / spacing^2): the smoothness
+  // of the correction between control points. A drift of peak A and period
+  // T has an acceleration of A (2 pi / T)^2: 2 m over 60 s gives 0.02.
+  double drift_acceleration_sigma_mps2 = 0.01;
+  double drift_angular_acceleration_sigma_deg_per_s2 = 0.001;
+  // Jumps of the GNSS/INS solution (GNSS coming back after an outage): a
+  // sample-to-sample step of the position (attitude) that departs from the
+  // motion of the neighbouring samples by more than this. The adjustment
+  // works on the trajectory with its jumps removed (the INS relative motion
+  // is continuous) and the GNSS prior follows the jumps, so the correction
+  // stays smooth; 0 disables the detection.
+  double jump_threshold_m = 0.05;
+  double jump_threshold_deg = 0.05;
+
+  // ---------------------------------------------------- control points
+  // Sub-pixel band vertices in the images.
+  double vertex_sigma_px = 0.5;
+  // Huber loss on image residuals, in sigmas.
+  double image_loss_scale = 3.0;
+  // Floor on the database's own sigma_xy/sigma_z (a database that claims
+  // millimetres is not believed).
+  double min_database_sigma_m = 0.01;
+  // Systematic offset of a whole database crossing (SURVEY_FORMAT.md: 5 to
+  // 15 cm), per axis; 0 disables the offset unknowns.
+  double crossing_offset_sigma_m = 0.07;
+  // Cauchy loss on the database prior of a vertex, in sigmas.
+  double control_loss_scale = 3.0;
+  // Share of matched crossings held out as check points (every k-th
+  // crossing in time order), as long as min_control_crossings remain.
+  double check_crossing_share = 0.2;
+  int min_control_crossings = 3;
+
+  // ---------------------------------------------------- blunders
+  // A control vertex is rejected when its normalised residual (image-only
+  // position minus database, Mahalanobis with the database sigma, the
+  // crossing offset, the triangulation and blunder_sigma_floor_m) exceeds
+  // this. 5 is far in the tail of chi(3) (p < 1e-4).
+  double blunder_threshold = 5.0;
+  double blunder_sigma_floor_m = 0.03;
+  int max_blunder_iterations = 6;
+  // A crossing with more than this share of its vertices rejected is
+  // rejected whole (repainted, wrongly matched).
+  double reject_crossing_share = 0.5;
+
+  // ---------------------------------------------------- tie points
+  double tie_sigma_px = 1.0;
+
+  // ---------------------------------------------------- rig calibration
+  // Estimate each camera's boresight rotation and lever arm (shared by all
+  // exposures) with these priors around rig.yaml.
+  bool self_calibrate_rig = false;
+  double boresight_sigma_deg = 0.2;
+  double lever_arm_sigma_m = 0.02;
+
+  // ---------------------------------------------------- covariance
+  // Posterior covariance of the corrected positions (trajectory sd_* of the
+  // output) when the problem has at most this many knots.
+  bool compute_covariance = true;
+  int max_knots_for_covariance = 3000;
+
+  SolverOptions solver;
+
+  // "" when valid, else "field = value: constraint".
+  std::string Check() const;
+};
+
+// What the adjustment reads. Pointers to data owned by the caller; the
+// vertex and match lists are the reconstruction's and the registration's
+// outputs, tie tracks are optional.
+struct AdjustmentInput {
+  const Rig* rig = nullptr;
+  const LocalFrame* frame = nullptr;
+  const Trajectory* trajectory = nullptr;
+  const ExposureTable* exposures = nullptr;
+  const RoadmarkDatabase* roadmarks = nullptr;
+  const std::vector<ReconstructedVertex>* vertices = nullptr;
+  const std::vector<VertexMatch>* matches = nullptr;
+  const std::vector<TieTrack>* tie_tracks = nullptr;
+};
+
+enum class ControlStatus {
+  kControl,   // used in the adjustment
+  kCheck,     // held out, evaluated only
+  kRejected,  // blunder: removed from the adjustment
+};
+const char* ControlStatusName(ControlStatus status);
+
+// One database vertex observed in the images.
+struct ControlPointResult {
+  std::string crossing_id;
+  int band = 0;
+  int db_vertex = 0;
+  ControlStatus status = ControlStatus::kControl;
+  Eigen::Vector3d database_enu = Eigen::Vector3d::Zero();
+  // Adjusted position (control), else the image-only position.
+  Eigen::Vector3d adjusted_enu = Eigen::Vector3d::Zero();
+  // Triangulated from the images with the corrected trajectory alone.
+  Eigen::Vector3d image_enu = Eigen::Vector3d::Zero();
+  double normalized_residual = 0.0;
+  double rms_px = 0.0;
+  int n_images = 0;
+};
+
+// RMS of one type of observation before (INS trajectory, database points)
+// and after the adjustment, in its unit.
+struct ObservationRms {
+  std::string type;
+  std::string unit;
+  int count = 0;
+  double before = 0.0;
+  double after = 0.0;
+};
+
+struct AdjustmentSummary {
+  bool usable = false;
+  std::string message;  // why not usable, or a one-line result
+  std::vector<std::string> warnings;
+  double sigma0 = 0.0;  // a-posteriori standard deviation of unit weight
+  int iterations = 0;   // Ceres iterations, all solves
+  int solves = 0;
+  double time_in_seconds = 0.0;
+  int num_exposures = 0;
+  int num_knots = 0;
+  int num_control_points = 0;
+  int num_check_points = 0;
+  int num_rejected_points = 0;
+  int num_control_crossings = 0;
+  int num_check_crossings = 0;
+  int num_tie_tracks = 0;
+  int num_residuals = 0;
+  std::vector<ObservationRms> rms;
+  // Adjusted (control) or image-only (check) minus database, metres.
+  double control_rmse_horizontal_m = 0.0;
+  double control_rmse_vertical_m = 0.0;
+  double check_rmse_horizontal_m = 0.0;
+  double check_rmse_vertical_m = 0.0;
+  // Size of the correction applied to the trajectory samples.
+  double max_correction_horizontal_m = 0.0;
+  double max_correction_vertical_m = 0.0;
+  double rms_correction_horizontal_m = 0.0;
+  // Jumps found in the input trajectory (GNSS returns).
+  int num_jumps = 0;
+  // Posterior sd of the corrected positions (median over the samples, 0
+  // when not computed).
+  double median_posterior_sd_horizontal_m = 0.0;
+  double median_posterior_sd_vertical_m = 0.0;
+  bool covariance_computed = false;
+
+  bool IsUsable() const { return usable; }
+  std::string BriefReport() const;
+};
+
+struct AdjustmentResult {
+  AdjustmentSummary summary;
+  TrajectoryCorrection correction;
+  // One per input sample, same times; sd_* are the posterior ones when
+  // computed, else the input's.
+  std::vector<TrajectorySample> corrected_samples;
+  std::vector<Pose> corrected_poses;  // ENU, per sample
+  // One per row of exposures.csv (camera projection centre, camera-to-ENU).
+  std::vector<CameraPose> camera_poses;
+  std::vector<ControlPointResult> control_points;
+  // Each reconstructed band placed with the corrected trajectory.
+  std::vector<AdjustedBand> bands;
+  // Adjusted rig mounting (rig.yaml's when not self-calibrating).
+  std::vector<Eigen::Isometry3d> T_body_cam;
+  // Tie points after adjustment (ENU), with their tracks.
+  std::vector<TieTrack> tie_tracks;
+};
+
+// Runs the adjustment. Never throws on bad data and never returns NaN
+// poses: a failed solve gives summary.usable = false and the reason in
+// summary.message. Without any usable control the input trajectory is
+// returned unchanged with a warning (usable). `progress(done, total)` is
+// called after each solve when set.
+AdjustmentResult AdjustTrajectory(
+    const AdjustmentOptions& options, const AdjustmentInput& input,
+    const std::function<void(int, int)>& progress = nullptr);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_

@@ -1,0 +1,257 @@
+#include "adjustment/trajectory_adjuster.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <set>
+
+#include "adjustment/adjustment_io.h"
+#include "adjustment/synthetic_survey.h"
+#include "survey/input_error.h"
+#include "tests/adjustment/pose_errors.h"
+#include "tests/survey/test_util.h"
+
+namespace zebrageo {
+namespace {
+
+struct Fixture {
+  SyntheticSurvey survey;
+  Trajectory trajectory;
+  AdjustmentInput Input() const {
+    AdjustmentInput input;
+    input.rig = &survey.rig;
+    input.frame = &survey.frame;
+    input.trajectory = &trajectory;
+    input.exposures = &survey.exposures;
+    input.roadmarks = &survey.database;
+    input.vertices = &survey.vertices;
+    input.matches = &survey.matches;
+    if (!survey.tie_tracks.empty()) input.tie_tracks = &survey.tie_tracks;
+    return input;
+  }
+};
+
+Fixture MakeFixture(const SyntheticSurveyOptions& options) {
+  Fixture f;
+  f.survey = MakeSyntheticSurvey(options);
+  f.trajectory = Trajectory(f.survey.measured_samples, f.survey.frame);
+  return f;
+}
+
+// 330 exposures (1 km at 10 m/s), a crossing every 80 m, 2 m drift.
+SyntheticSurveyOptions KilometreOptions() {
+  SyntheticSurveyOptions options;
+  options.num_exposures = 330;
+  options.database_offset_m = 0.03;
+  return options;
+}
+
+TEST(TrajectoryAdjuster, RecoversTwoMetreDriftToCentimetres) {
+  SyntheticSurveyOptions options = KilometreOptions();
+  options.tie_points_per_exposure = 6;
+  const Fixture f = MakeFixture(options);
+  const AdjustmentResult result =
+      AdjustTrajectory(AdjustmentOptions(), f.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  const PoseErrors before = ScorePoses(f.survey, InputCameraPoses(f.survey));
+  const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
+  EXPECT_GT(before.rmse_horizontal_m, 0.5);
+  EXPECT_LT(after.rmse_horizontal_m, 0.06);
+  EXPECT_LT(after.rmse_vertical_m, 0.05);
+  EXPECT_LT(after.rmse_attitude_deg, 0.04);
+  EXPECT_LT(after.rmse_attitude_deg, before.rmse_attitude_deg);
+  EXPECT_EQ(result.summary.num_rejected_points, 0);
+  EXPECT_GT(result.summary.num_tie_tracks, 100);
+  // One pose per image, one corrected sample per input sample, same times.
+  EXPECT_EQ(result.camera_poses.size(), f.survey.exposures.images.size());
+  ASSERT_EQ(result.corrected_samples.size(), f.survey.measured_samples.size());
+  for (size_t i = 0; i < result.corrected_samples.size(); ++i) {
+    ASSERT_EQ(result.corrected_samples[i].time,
+              f.survey.measured_samples[i].time);
+  }
+  EXPECT_TRUE(result.summary.covariance_computed);
+  EXPECT_GT(result.summary.median_posterior_sd_horizontal_m, 0.0);
+  EXPECT_LT(result.summary.median_posterior_sd_horizontal_m, 0.2);
+}
+
+TEST(TrajectoryAdjuster, CheckPointsAreHeldOutAndMeasureAnHonestAccuracy) {
+  const Fixture f = MakeFixture(KilometreOptions());
+  const AdjustmentResult result =
+      AdjustTrajectory(AdjustmentOptions(), f.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  EXPECT_GE(result.summary.num_check_crossings, 2);
+  EXPECT_GE(result.summary.num_control_crossings, 8);
+  std::set<std::string> check, control;
+  for (const ControlPointResult& p : result.control_points) {
+    (p.status == ControlStatus::kCheck ? check : control).insert(p.crossing_id);
+  }
+  for (const std::string& c : check) EXPECT_EQ(control.count(c), 0u) << c;
+  // The check RMSE holds the trajectory error and the database error
+  // (2 cm vertex noise, 3 cm crossing offsets): it must be of that size,
+  // neither hidden nor inflated.
+  const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
+  const double database_h = std::sqrt(2.0) * std::hypot(0.02, 0.03);
+  const double expected = std::hypot(after.rmse_horizontal_m, database_h);
+  EXPECT_GT(result.summary.check_rmse_horizontal_m, 0.4 * expected);
+  EXPECT_LT(result.summary.check_rmse_horizontal_m, 2.5 * expected);
+}
+
+TEST(TrajectoryAdjuster, WrongControlPointsAreFlaggedAndRemoved) {
+  Fixture f = MakeFixture(KilometreOptions());
+  // A digitising blunder on one vertex (0.6 m) and a whole crossing 1.5 m
+  // away from where it is (a wrong match).
+  const Eigen::Vector3d shift(0.4, -0.45, 0.0);
+  for (RoadmarkBand& band : f.survey.database.bands) {
+    if (band.crossing_id == "X4" && band.band == 2) {
+      const Eigen::Vector3d p = f.survey.frame.EnuFromGeodetic(band.corners[1]);
+      band.corners[1] = f.survey.frame.GeodeticFromEnu(p + shift);
+    }
+    if (band.crossing_id == "X9") {
+      for (Geodetic& corner : band.corners) {
+        const Eigen::Vector3d p = f.survey.frame.EnuFromGeodetic(corner);
+        corner =
+            f.survey.frame.GeodeticFromEnu(p + Eigen::Vector3d(1.2, 0.9, 0.0));
+      }
+    }
+  }
+  AdjustmentOptions options;
+  options.check_crossing_share = 0.0;  // every crossing in the adjustment
+  const AdjustmentResult result = AdjustTrajectory(options, f.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  int rejected_x9 = 0, total_x9 = 0, rejected_other = 0;
+  bool blunder_rejected = false;
+  for (const ControlPointResult& p : result.control_points) {
+    const bool rejected = p.status == ControlStatus::kRejected;
+    if (p.crossing_id == "X9") {
+      ++total_x9;
+      rejected_x9 += rejected;
+    } else if (p.crossing_id == "X4" && p.band == 2 && p.db_vertex == 1) {
+      blunder_rejected = rejected;
+      EXPECT_GT(p.normalized_residual, options.blunder_threshold);
+    } else {
+      rejected_other += rejected;
+    }
+  }
+  EXPECT_TRUE(blunder_rejected);
+  EXPECT_GT(total_x9, 0);
+  EXPECT_EQ(rejected_x9, total_x9);
+  EXPECT_LE(rejected_other, 2);
+  EXPECT_FALSE(result.summary.warnings.empty());
+  const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
+  EXPECT_LT(after.rmse_horizontal_m, 0.08);
+}
+
+TEST(TrajectoryAdjuster, SelfCalibrationRecoversALeverArmError) {
+  Fixture f = MakeFixture(KilometreOptions());
+  // rig.yaml's left lever arm is 4 cm off the truth the data were made with.
+  const Eigen::Vector3d truth =
+      f.survey.rig.cameras[0].T_body_cam.translation();
+  f.survey.rig.cameras[0].T_body_cam.translation() +=
+      Eigen::Vector3d(0.0, 0.04, 0.0);
+  AdjustmentOptions options;
+  options.self_calibrate_rig = true;
+  options.lever_arm_sigma_m = 0.05;
+  const AdjustmentResult result = AdjustTrajectory(options, f.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  ASSERT_EQ(result.T_body_cam.size(), 2u);
+  // The stereo baseline is what the images measure: the error shrinks.
+  EXPECT_LT((result.T_body_cam[0].translation() - truth).norm(), 0.8 * 0.04);
+}
+
+TEST(TrajectoryAdjuster, WithoutControlReturnsTheInputTrajectoryAndWarns) {
+  Fixture f = MakeFixture(KilometreOptions());
+  f.survey.matches.clear();
+  const AdjustmentResult result =
+      AdjustTrajectory(AdjustmentOptions(), f.Input());
+  ASSERT_TRUE(result.summary.IsUsable());
+  ASSERT_FALSE(result.summary.warnings.empty());
+  EXPECT_NE(result.summary.warnings[0].find("no control"), std::string::npos);
+  const Trajectory measured(f.survey.measured_samples, f.survey.frame);
+  ASSERT_EQ(result.corrected_poses.size(), measured.poses().size());
+  for (size_t i = 0; i < measured.poses().size(); ++i) {
+    EXPECT_LT(
+        (result.corrected_poses[i].p_enu - measured.poses()[i].p_enu).norm(),
+        1e-9);
+  }
+}
+
+TEST(TrajectoryAdjuster, InvalidOptionsGiveAnUnusableSummaryNamingTheField) {
+  const Fixture f = MakeFixture(KilometreOptions());
+  AdjustmentOptions options;
+  options.knot_spacing_s = -1.0;
+  const AdjustmentResult result = AdjustTrajectory(options, f.Input());
+  EXPECT_FALSE(result.summary.IsUsable());
+  EXPECT_NE(result.summary.message.find("knot_spacing_s = -1"),
+            std::string::npos);
+  EXPECT_TRUE(result.camera_poses.empty());
+}
+
+TEST(AdjustmentOptions, CheckNamesFieldValueAndConstraint) {
+  AdjustmentOptions options;
+  EXPECT_EQ(options.Check(), "");
+  options.check_crossing_share = 1.0;
+  EXPECT_EQ(options.Check(), "check_crossing_share = 1: must be in [0, 1)");
+  options = AdjustmentOptions();
+  options.solver.num_threads = 0;
+  EXPECT_EQ(options.Check(), "solver.num_threads = 0: must be >= 1");
+  options = AdjustmentOptions();
+  options.vertex_sigma_px = 0.0;
+  EXPECT_EQ(options.Check(), "vertex_sigma_px = 0: must be finite and > 0");
+}
+
+TEST(AdjustmentIo, WritesEveryContractOutputReadableByTheSurveyReaders) {
+  SyntheticSurveyOptions options = KilometreOptions();
+  options.num_exposures = 120;
+  const SyntheticSurvey survey = MakeSyntheticSurvey(options);
+  TemporaryFolder folder;
+  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
+  const AdjustmentData data =
+      LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
+  EXPECT_EQ(data.missing_images,
+            static_cast<int>(survey.exposures.images.size()));
+  const AdjustmentOptions adjustment_options;
+  const AdjustmentResult result =
+      AdjustTrajectory(adjustment_options, data.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  WriteAdjustmentResults(data, adjustment_options, result, nullptr,
+                         folder.Path("results"));
+  const auto poses =
+      ReadCameraPoses(folder.Path("results/poses.csv"), "poses.csv");
+  EXPECT_EQ(poses.size(), survey.exposures.images.size());
+  const auto samples = ReadTrajectorySamples(
+      folder.Path("results/trajectory_corrected.csv"), "trajectory_corrected");
+  ASSERT_EQ(samples.size(), survey.measured_samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    ASSERT_EQ(samples[i].time, survey.measured_samples[i].time);
+  }
+  const auto gcps = ReadGcpResiduals(folder.Path("results/gcp_residuals.csv"),
+                                     "gcp_residuals.csv");
+  EXPECT_EQ(gcps.size(), result.control_points.size());
+  EXPECT_FALSE(
+      ReadAdjustedBands(folder.Path("results/bands.geojson"), "bands.geojson")
+          .empty());
+  for (const char* name :
+       {"adjustment.json", "report.json", "colmap/cameras.txt",
+        "colmap/images.txt", "colmap/points3D.txt"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(
+        folder.Path(std::string("results/") + name)))
+        << name;
+  }
+}
+
+TEST(AdjustmentIo, MissingStageOutputsNameTheStageToRun) {
+  const SyntheticSurvey survey = MakeSyntheticSurvey(KilometreOptions());
+  TemporaryFolder folder;
+  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
+  std::filesystem::remove(folder.Path("results/matches.csv"));
+  try {
+    LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("zebrageo match"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace zebrageo
