@@ -13,6 +13,7 @@
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
+#include "tools/stages.h"
 
 namespace zebrageo {
 namespace {
@@ -32,9 +33,17 @@ void RunAdjust(const AdjustArguments& args) {
   options.solver.num_threads = args.threads;
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
+  RunAdjustStage(args.stage.survey, args.stage.results, options,
+                 args.tie_points);
+}
 
-  const AdjustmentData data =
-      LoadAdjustmentData(args.stage.survey, args.stage.results);
+}  // namespace
+
+std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
+                                        const std::string& results_folder,
+                                        const AdjustmentOptions& options,
+                                        bool tie_points) {
+  const AdjustmentData data = LoadAdjustmentData(survey_folder, results_folder);
   LOG(INFO) << "adjust: " << data.vertices.size() << " reconstructed vertices, "
             << data.matches.size() << " matches, "
             << data.exposures.exposures.size() << " exposures";
@@ -42,7 +51,7 @@ void RunAdjust(const AdjustArguments& args) {
   std::vector<TieTrack> tracks;
   TiePointSummary tie_summary;
   const bool use_ties =
-      args.tie_points &&
+      tie_points &&
       data.missing_images < static_cast<int>(data.exposures.images.size());
   if (use_ties) {
     ProgressBar bar("tie points");
@@ -62,13 +71,12 @@ void RunAdjust(const AdjustArguments& args) {
     throw StageFailedError("adjust: " + result.summary.message +
                            "; no results were written");
   }
-  RemoveStaleTemporaries(args.stage.results);
+  RemoveStaleTemporaries(results_folder);
   WriteAdjustmentResults(data, options, result,
-                         use_ties ? &tie_summary : nullptr, args.stage.results);
+                         use_ties ? &tie_summary : nullptr, results_folder);
   LOG(INFO) << "adjust: " << result.summary.BriefReport();
+  return data.warnings;
 }
-
-}  // namespace
 
 void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands) {
   auto args = std::make_shared<AdjustArguments>();

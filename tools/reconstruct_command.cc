@@ -13,6 +13,7 @@
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
+#include "tools/stages.h"
 
 namespace zebrageo {
 namespace {
@@ -28,11 +29,7 @@ struct ReconstructArguments {
       ReconstructionOptions().long_sides.min_long_side_length_m;
 };
 
-void RunReconstruct(const ReconstructArguments& args) {
-  SurveyLoadOptions load_options;
-  load_options.load_roadmarks = false;
-  const Survey survey = LoadSurvey(args.stage.survey, load_options);
-
+ReconstructionOptions OptionsFrom(const ReconstructArguments& args) {
   ReconstructionOptions options;
   options.threads = args.threads;
   options.debug_image_folder = args.debug_images;
@@ -41,43 +38,56 @@ void RunReconstruct(const ReconstructArguments& args) {
   options.long_sides.min_long_side_length_m = args.min_long_side_length_m;
   const std::string error = options.Check();
   if (!error.empty()) throw UsageError(error);
+  return options;
+}
 
-  std::filesystem::create_directories(args.stage.results);
-  std::vector<ReconstructedVertex> vertices;
+void RunReconstruct(const ReconstructArguments& args) {
+  const ReconstructionOptions options = OptionsFrom(args);
+  SurveyLoadOptions load_options;
+  load_options.load_roadmarks = false;
+  const Survey survey = LoadSurvey(args.stage.survey, load_options);
   ProgressBar bar("reconstruct");
-  const ReconstructionSummary summary =
-      ReconstructSurvey(survey, options, &vertices, bar.Callback());
+  RunReconstructStage(survey, options, args.stage.results, bar.Callback());
   bar.Finish();
+}
+
+}  // namespace
+
+std::vector<std::string> RunReconstructStage(
+    const Survey& survey, const ReconstructionOptions& options,
+    const std::string& results_folder,
+    const std::function<void(int, int)>& progress) {
+  std::filesystem::create_directories(results_folder);
+  std::vector<ReconstructedVertex> vertices;
+  const ReconstructionSummary summary =
+      ReconstructSurvey(survey, options, &vertices, progress);
   if (!summary.IsUsable()) throw StageFailedError(summary.message);
 
+  StepTimings mean = summary.timings;
+  const double n = std::max(1, summary.pairs_processed);
+  mean.read_images_s /= n;
+  mean.rectify_s /= n;
+  mean.edges_s /= n;
+  mean.matching_s /= n;
+  mean.road_plane_s /= n;
+  mean.long_sides_s /= n;
+  mean.bands_s /= n;
+  mean.debug_images_s /= n;
   std::vector<std::string> comments = {
       "zebrageo reconstruct: " + summary.BriefReport(),
-      "per stereo pair: " + [&] {
-        StepTimings mean = summary.timings;
-        const double n = std::max(1, summary.pairs_processed);
-        mean.read_images_s /= n;
-        mean.rectify_s /= n;
-        mean.edges_s /= n;
-        mean.matching_s /= n;
-        mean.road_plane_s /= n;
-        mean.long_sides_s /= n;
-        mean.bands_s /= n;
-        mean.debug_images_s /= n;
-        return mean.Report();
-      }()};
+      "per stereo pair: " + mean.Report()};
   for (const std::string& warning : summary.warnings) {
     comments.push_back("warning: " + warning);
   }
   WriteReconstructedBands(
       vertices, comments,
-      (std::filesystem::path(args.stage.results) / kReconstructedBandsFile)
+      (std::filesystem::path(results_folder) / kReconstructedBandsFile)
           .string());
   LOG(INFO) << "reconstruct: " << summary.BriefReport() << " in "
             << summary.wall_time_s << " s";
   LOG(INFO) << "reconstruct: " << comments[1];
+  return summary.warnings;
 }
-
-}  // namespace
 
 void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands) {
   auto args = std::make_shared<ReconstructArguments>();

@@ -1,23 +1,143 @@
 // `zebrageo run SURVEY -o RESULTS` and `zebrageo report SURVEY -o RESULTS`.
-#include <memory>
+#include <glog/logging.h>
+#include <sys/resource.h>
 
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "registration/match_stage.h"
+#include "survey/results.h"
+#include "survey/survey.h"
 #include "tools/commands.h"
+#include "tools/exit_codes.h"
+#include "tools/pipeline.h"
+#include "tools/report/report.h"
+#include "tools/stages.h"
 
 namespace zebrageo {
+namespace {
+
+struct RunArguments {
+  StageArguments stage;
+  std::string from_stage;
+  int threads = 0;
+  bool tie_points = true;
+};
+
+double PeakMemoryMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+std::vector<std::string> SurveyInputFiles(const Survey& survey) {
+  std::vector<std::string> files = {survey.PathOf("survey.yaml")};
+  for (const std::string* file :
+       {&survey.manifest.rig, &survey.manifest.trajectory,
+        &survey.manifest.exposures, &survey.manifest.roadmarks}) {
+    files.push_back(survey.PathOf(*file));
+  }
+  for (const ExposureImage& image : survey.exposures.images) {
+    files.push_back(survey.PathOf(image.image));
+  }
+  return files;
+}
+
+void Run(const RunArguments& args) {
+  // Validate everything before the first output is written: a survey that
+  // cannot be processed leaves the results folder untouched.
+  const Survey survey = LoadSurvey(args.stage.survey);
+  ReconstructionOptions reconstruction;
+  reconstruction.threads = args.threads;
+  MatchOptions matching;
+  AdjustmentOptions adjustment;
+  if (args.threads > 0) adjustment.solver.num_threads = args.threads;
+  for (const std::string& problem :
+       {reconstruction.Check(), matching.Check(), adjustment.Check()}) {
+    if (!problem.empty()) throw UsageError(problem);
+  }
+  const std::string results = args.stage.results;
+
+  std::vector<PipelineStage> stages;
+  stages.push_back({"reconstruct",
+                    {kReconstructedBandsFile},
+                    [&](const std::function<void(int, int)>& progress) {
+                      return RunReconstructStage(survey, reconstruction,
+                                                 results, progress);
+                    }});
+  stages.push_back({"match",
+                    {kMatchesFile, kCrossingDecisionsFile},
+                    [&](const std::function<void(int, int)>& progress) {
+                      const MatchResult result =
+                          RunMatchStage(survey, results, matching, progress);
+                      if (!result.summary.IsUsable()) {
+                        throw StageFailedError("match: " +
+                                               result.summary.message);
+                      }
+                      LOG(INFO) << "match: " << result.summary.BriefReport();
+                      return std::vector<std::string>();
+                    }});
+  stages.push_back({"adjust",
+                    {kTrajectoryCorrectedFile, kPosesFile, kGcpResidualsFile,
+                     kBandsGeoJsonFile},
+                    [&](const std::function<void(int, int)>&) {
+                      return RunAdjustStage(survey.folder, results, adjustment,
+                                            args.tie_points);
+                    }});
+  std::ostringstream settings;
+  settings << "threads-independent;ties=" << args.tie_points;
+  const PipelineRun run = RunPipeline(
+      results, InputFingerprint(SurveyInputFiles(survey), settings.str()),
+      stages, PipelineOptions{args.from_stage});
+
+  ReportInputs inputs;
+  inputs.survey = &survey;
+  inputs.results_folder = results;
+  inputs.timings = run.timings;
+  inputs.warnings = run.warnings;
+  inputs.peak_memory_mb = PeakMemoryMb();
+  const nlohmann::json report = WriteReport(inputs, ReportOptions());
+  for (const auto& warning : report["warnings"]) {
+    LOG(WARNING) << warning.get<std::string>();
+  }
+  std::cout << "report: " << results << "/" << kReportHtmlFile << "\n";
+}
+
+}  // namespace
 
 void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
-  auto run_args = std::make_shared<StageArguments>();
+  auto run_args = std::make_shared<RunArguments>();
   CLI::App* run = AddStageSubcommand(
-      app, "run", "All stages (reconstruct, match, adjust), then the report.",
-      run_args.get());
-  commands->push_back({run, NotImplementedStage(run_args, "run", "issue 8")});
+      app, "run",
+      "All stages (reconstruct, match, adjust), then report.json and "
+      "report.html. A rerun resumes after the last completed stage.",
+      &run_args->stage);
+  run->add_option("--from", run_args->from_stage,
+                  "redo from this stage: reconstruct, match or adjust");
+  run->add_option("--threads", run_args->threads,
+                  "worker threads (0: one per hardware thread)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  run->add_flag("!--no-tie-points", run_args->tie_points,
+                "do not match image features between exposures");
+  commands->push_back({run, [run_args] { Run(*run_args); }});
+
   auto report_args = std::make_shared<StageArguments>();
   CLI::App* report = AddStageSubcommand(
       app, "report",
       "Write report.json and report.html from an existing results folder.",
       report_args.get());
-  commands->push_back(
-      {report, NotImplementedStage(report_args, "report", "issue 8")});
+  commands->push_back({report, [report_args] {
+                         const Survey survey = LoadSurvey(report_args->survey);
+                         ReportInputs inputs;
+                         inputs.survey = &survey;
+                         inputs.results_folder = report_args->results;
+                         WriteReport(inputs, ReportOptions());
+                         std::cout << "report: " << report_args->results << "/"
+                                   << kReportHtmlFile << "\n";
+                       }});
 }
 
 }  // namespace zebrageo

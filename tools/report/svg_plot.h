@@ -1,0 +1,68 @@
+// Minimal SVG charts for the self-contained HTML report: line and scatter
+// plots with axes and ticks, colour-mapped points, arrows and histograms.
+// No network, no JavaScript: the SVG is inlined in report.html.
+#ifndef ZEBRAGEO_TOOLS_REPORT_SVG_PLOT_H_
+#define ZEBRAGEO_TOOLS_REPORT_SVG_PLOT_H_
+
+#include <string>
+#include <vector>
+
+namespace zebrageo {
+
+struct PlotSeries {
+  std::string label;
+  std::string colour = "#1f77b4";  // any CSS colour
+  std::vector<double> x;
+  std::vector<double> y;
+  bool markers = false;  // points instead of a polyline
+  // Per-point values mapped to a colour scale (markers only); empty: plain.
+  std::vector<double> colour_values;
+};
+
+struct PlotArrow {
+  double x = 0, y = 0, dx = 0, dy = 0;  // in data units (after `scale`)
+  std::string colour = "#d62728";
+};
+
+class SvgPlot {
+ public:
+  SvgPlot(std::string title, std::string x_label, std::string y_label,
+          int width_px = 720, int height_px = 320);
+
+  void AddSeries(PlotSeries series);
+  void AddArrow(const PlotArrow& arrow);
+  // Keep x and y on the same scale (maps).
+  void SetEqualAspect(bool equal) { equal_aspect_ = equal; }
+  // Colour scale legend for colour_values, e.g. "correction (m)".
+  void SetColourScale(double min_value, double max_value, std::string label);
+  // Text drawn under the title (units, notes).
+  void SetNote(std::string note) { note_ = std::move(note); }
+
+  std::string Render() const;
+
+ private:
+  std::string title_, x_label_, y_label_, note_;
+  int width_px_, height_px_;
+  std::vector<PlotSeries> series_;
+  std::vector<PlotArrow> arrows_;
+  bool equal_aspect_ = false;
+  bool has_colour_scale_ = false;
+  double colour_min_ = 0.0, colour_max_ = 1.0;
+  std::string colour_label_;
+};
+
+// A histogram of `values` with `bins` bins as an SVG bar chart.
+std::string RenderHistogram(const std::string& title,
+                            const std::string& x_label,
+                            const std::vector<double>& values, int bins,
+                            const std::string& colour = "#1f77b4");
+
+// Viridis-like colour for t in [0, 1].
+std::string ColourScale(double t);
+
+// Escapes &, <, >, " for HTML/SVG text.
+std::string EscapeHtml(const std::string& text);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_TOOLS_REPORT_SVG_PLOT_H_
