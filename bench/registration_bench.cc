@@ -145,6 +145,16 @@ void BM_LoadAndIndex100kBands(benchmark::State& state) {
 }
 BENCHMARK(BM_LoadAndIndex100kBands)->Unit(benchmark::kMillisecond);
 
+// The survey reader alone (JSON parse and validation): most of the above.
+void BM_ReadRoadmarks100kBands(benchmark::State& state) {
+  const std::string& path = CityDatabaseFile();
+  for (auto _ : state) {
+    const RoadmarkDatabase db = ReadRoadmarks(path, "roadmarks.geojson");
+    benchmark::DoNotOptimize(db.bands.data());
+  }
+}
+BENCHMARK(BM_ReadRoadmarks100kBands)->Unit(benchmark::kMillisecond);
+
 void BM_Index100kBands(benchmark::State& state) {
   const RoadmarkDatabase& db = CityDatabase();
   const LocalFrame frame = CityFrame();

@@ -676,7 +676,7 @@ double Matcher::WindowEvidence(int o, const PoseCorrection& c,
   const double t = input_.observations[o].time_s;
   std::map<int, double> local;
   std::map<int, double>& by_unit = units != nullptr ? *units : local;
-  std::set<int> seen;                 // database bands hit in the window
+  std::set<int> seen;                // database bands hit in the window
   std::map<int, int> missing_views;  // database band -> views missing it
   for (int m = window_[o].first; m < window_[o].second; ++m) {
     const int q = by_time_[m];
@@ -684,10 +684,9 @@ double Matcher::WindowEvidence(int o, const PoseCorrection& c,
     if (g == nullptr) continue;  // no band of q fits c: no information
     const Obs& obs = obs_[q];
     auto unit_of = [&](int rec) {
-      return units == nullptr
-                 ? -1
-                 : EndUnit(Apply(placement, obs.vehicle,
-                                 obs.bands[rec].shape.centre));
+      return units == nullptr ? -1
+                              : EndUnit(Apply(placement, obs.vehicle,
+                                              obs.bands[rec].shape.centre));
     };
     for (const Hit& hit : g->eval.hits) {
       by_unit[unit_of(hit.rec)] += 1.0;
@@ -854,8 +853,7 @@ void Matcher::DecideAlone(int o) {
       continue;
     }
     const Margin m = MarginOver(o, h, list[k]);
-    const double deciding =
-        options_.require_both_ends ? m.both_ends : m.raw;
+    const double deciding = options_.require_both_ends ? m.both_ends : m.raw;
     if (deciding < (options_.require_both_ends ? both_ends : margin)) {
       runner = static_cast<int>(k);
     }
@@ -868,8 +866,7 @@ void Matcher::DecideAlone(int o) {
     ev.runner_up_score = r.aggregated;
     ev.runner_up = DescribeAlternative(obs, h, r);
   }
-  const double robust_margin =
-      options_.require_both_ends ? both_ends : margin;
+  const double robust_margin = options_.require_both_ends ? both_ends : margin;
   ev.robust_margin = std::isfinite(robust_margin) ? robust_margin : 0.0;
   ev.both_ends_margin = std::isfinite(both_ends) ? both_ends : 0.0;
   ev.decision = Decision::kRefused;

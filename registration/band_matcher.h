@@ -26,20 +26,29 @@
 //     crossing, -unexplained_band_weight per band outside every crossing.
 //  2. Aggregation. The drift changes slowly, so observations within
 //     `window_s` share the correction: a hypothesis is scored by the sum over
-//     those observations of their own hypothesis at the same correction.
+//     those observations of their own hypothesis at the same correction
+//     (a missing database band counts for at most max_missing_views views,
+//     and not at all if another view saw it: parked vehicles hide bands).
 //  3. Decision. The best hypothesis must beat every distinct alternative
 //     (another band offset, another crossing) by `min_margin`; with
 //     `require_both_ends`, even without the evidence of the crossing end
 //     that favours it most (a band missing on either side at that end must
 //     not decide the 1 m periodicity).
 //  4. Continuity. Crossings matched alone must imply consistent corrections
-//     (within neighbour_tolerance_m + drift_rate_m_per_s * time apart);
+//     (within neighbour_tolerance_m + max_drift_rate_m_per_s * time apart);
 //     outliers are refused, and observations ambiguous alone are resolved
-//     when the correction interpolated from matched neighbours singles out
-//     one hypothesis.
+//     when the correction predicted from matched neighbours (with an error
+//     bound below max_resolve_bound_m) singles out one hypothesis.
 //  5. Database faults are detected and reported: crossings missing from the
 //     database, crossings gone from the street, bands missing on either
 //     side, crossings shifted (repainted) by decimetres.
+//
+// Known limit: with require_both_ends = false (the default), a crossing
+// whose far end is never in view is decided by its near end alone; an end
+// band hidden from EVERY view (or missing from the street without the
+// database knowing) then looks like a one-band shift. Continuity with
+// neighbouring crossings catches it when they are close in time; otherwise
+// set require_both_ends.
 #ifndef ZEBRAGEO_REGISTRATION_BAND_MATCHER_H_
 #define ZEBRAGEO_REGISTRATION_BAND_MATCHER_H_
 
@@ -157,7 +166,7 @@ struct MatchOptions {
   // ~0.01 m/s^2).
   double resolve_base_m = 0.1;
   double max_drift_acceleration_m_per_s2 = 0.01;
-  double max_resolve_bound_m = 0.35;
+  double max_resolve_bound_m = 0.4;
   double max_sd_ratio = 2.0;
 
   // --- Database faults --------------------------------------------------
@@ -168,7 +177,7 @@ struct MatchOptions {
   // adjustment by the shift).
   bool refuse_shifted_crossings = false;
   // Views needed before a crossing or band is reported missing or gone.
-  int min_views_for_fault = 3;
+  int min_views_for_fault = 2;
 
   // "" or the first invalid field, e.g. "max_drift_m = -1: must be > 0".
   std::string Check() const;

@@ -208,6 +208,37 @@ TEST(BandMatcher, ResolvesInteriorViewsFromAMatchedNeighbourCrossing) {
             0);
 }
 
+TEST(BandMatcher, IgnoresAnEndBandHiddenFromSomeViewsByAParkedVehicle) {
+  // Band 1 of every crossing is hidden until the vehicle is within 9 m:
+  // the far views must not count its absence against the right offset.
+  for (int seed = 1; seed <= 3; ++seed) {
+    SyntheticSceneOptions options = Street(seed);
+    for (SyntheticCrossingSpec& c : options.crossings) {
+      c.occluded_bands = 1;
+      c.occluded_beyond_m = 9.0;
+    }
+    const SceneRun run = MatchScene(options);
+    SCOPED_TRACE(run.result.summary.BriefReport());
+    EXPECT_EQ(run.score.wrong, 0);
+    EXPECT_GE(MatchedShare(run.score), 0.95);
+  }
+}
+
+TEST(BandMatcher, WithBothEndsRequiredNeverGuessesAnEndBandHiddenFromAllViews) {
+  // Bands 1 and 2 are never seen: from the bands alone this is a crossing
+  // two bands narrower. Requiring both ends to agree refuses it.
+  SyntheticSceneOptions options = Street(5);
+  for (SyntheticCrossingSpec& c : options.crossings) {
+    c.occluded_bands = 2;
+    c.occluded_beyond_m = 6.0;
+  }
+  MatchOptions match;
+  match.require_both_ends = true;
+  const SceneRun run = MatchScene(options, match);
+  SCOPED_TRACE(run.result.summary.BriefReport());
+  EXPECT_EQ(run.score.wrong, 0);
+}
+
 TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
   // The database has crossing C03 one band period off (a wrong survey): it
   // still fits perfectly alone, but implies a correction 1 m away from the
