@@ -9,6 +9,7 @@
 #include <map>
 #include <numeric>
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "survey/image_io.h"
@@ -136,6 +137,19 @@ std::vector<TieTrack> BuildTieTracks(
       const double scale = std::pow(kOrbScaleFactor, kp.octave);
       kp.pt.x += static_cast<float>(0.5 * (scale - 1.0));
       kp.pt.y += static_cast<float>(0.5 * (scale - 1.0));
+    }
+    if (options.refine_subpixel && !f.keypoints.empty()) {
+      std::vector<cv::Point2f> corners;
+      for (const cv::KeyPoint& kp : f.keypoints) corners.push_back(kp.pt);
+      cv::cornerSubPix(
+          grey, corners, cv::Size(2, 2), cv::Size(-1, -1),
+          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10,
+                           0.01));
+      for (size_t k = 0; k < corners.size(); ++k) {
+        // Keep the detector's position when the refinement wanders off.
+        const cv::Point2f d = corners[k] - f.keypoints[k].pt;
+        if (d.dot(d) < 1.0) f.keypoints[k].pt = corners[k];
+      }
     }
     const Camera& camera = rig.cameras[image.camera].camera;
     f.normalized.resize(f.keypoints.size());
