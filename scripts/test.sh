@@ -17,7 +17,9 @@ ctest --test-dir "$here/build" --output-on-failure -j "$jobs"
 # warnings inside Eigen. For now it covers the survey library, the base
 # every stage reads its input with (see README.md, "Sanitizers").
 "$here/scripts/setup.sh"
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$here}"
 cmake -S "$here" -B "$here/build-asan" -G Ninja -DZEBRAGEO_WERROR=OFF \
+  -DCMAKE_CXX_COMPILER_LAUNCHER=ccache \
   -DZEBRAGEO_SANITIZE=ON -DZEBRAGEO_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=None \
   "-DCMAKE_CXX_FLAGS=-O1 -g1" "-DZEBRAGEO_TEST_DIRS=${ZEBRAGEO_SANITIZE_TEST_DIRS:-survey}" \
   >/dev/null
