@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "reconstruction/reconstruction.h"
+#include "survey/input_error.h"
 #include "survey/results.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
@@ -53,6 +55,32 @@ void RunReconstruct(const ReconstructArguments& args) {
 
 }  // namespace
 
+void ThrowIfTooManyUnreadable(const Survey& survey,
+                              const ReconstructionSummary& summary) {
+  // Images that exist but cannot be decoded are only found here (loading
+  // checks existence); the same share as for missing images makes the survey
+  // invalid rather than quietly thin.
+  const int total = static_cast<int>(survey.exposures.exposures.size());
+  const double max_fraction = SurveyLoadOptions().max_missing_image_fraction;
+  if (summary.exposures_skipped == 0 ||
+      summary.exposures_skipped <= max_fraction * total) {
+    return;
+  }
+  // The skipped exposures' warnings name the image and the problem.
+  std::string first = "?";
+  for (const std::string& warning : summary.warnings) {
+    if (warning.find("skipped") != std::string::npos) {
+      first = warning;
+      break;
+    }
+  }
+  std::ostringstream problem;
+  problem << summary.exposures_skipped << " of " << total
+          << " exposures have an unreadable image (more than "
+          << max_fraction * 100 << "%); first: " << first;
+  throw InputError(survey.manifest.exposures, 0, problem.str());
+}
+
 std::vector<std::string> RunReconstructStage(
     const Survey& survey, const ReconstructionOptions& options,
     const std::string& results_folder,
@@ -61,6 +89,7 @@ std::vector<std::string> RunReconstructStage(
   std::vector<ReconstructedVertex> vertices;
   const ReconstructionSummary summary =
       ReconstructSurvey(survey, options, &vertices, progress);
+  ThrowIfTooManyUnreadable(survey, summary);
   if (!summary.IsUsable()) throw StageFailedError(summary.message);
 
   StepTimings mean = summary.timings;

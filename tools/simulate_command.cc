@@ -10,6 +10,7 @@
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
+#include "tools/simulator/bad_survey.h"
 #include "tools/simulator/simulator.h"
 
 namespace zebrageo {
@@ -21,6 +22,7 @@ struct SimulateArguments {
   std::string output;
   std::vector<std::string> overrides;
   bool no_images = false;
+  std::string bad;
 };
 
 }  // namespace
@@ -40,6 +42,10 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--set", args->overrides,
                   "override a knob of the preset, e.g. --set road_length_m=300 "
                   "(repeatable; see datasets/README.md)");
+  sub->add_option("--bad", args->bad,
+                  "write a small broken survey of this kind for the "
+                  "bad-input suite (truth/meta.json says what to expect; "
+                  "kinds in README.md)");
   sub->add_flag("--no-images", args->no_images,
                 "write only the geometry (no rendering)");
   commands->push_back(
@@ -48,6 +54,10 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
          std::string error = ApplyPreset(args->preset, &options);
          if (!error.empty()) throw UsageError(error);
          options.seed = args->seed;
+         if (!args->bad.empty()) {
+           error = ApplyBadSurveySettings(args->bad, &options);
+           if (!error.empty()) throw UsageError(error);
+         }
          for (const std::string& item : args->overrides) {
            error = SetOption(item, &options);
            if (!error.empty()) throw UsageError("--set " + item + ": " + error);
@@ -58,6 +68,7 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
          ProgressBar progress("simulate");
          SimulateSurvey(options, args->output, progress.Callback());
          progress.Finish();
+         if (!args->bad.empty()) BreakSurvey(args->bad, args->output);
          LOG(INFO) << "wrote survey " << args->output;
        }});
 }

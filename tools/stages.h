@@ -20,6 +20,11 @@ std::vector<std::string> RunReconstructStage(
     const std::string& results_folder,
     const std::function<void(int, int)>& progress);
 
+// Throws InputError when more than SurveyLoadOptions's
+// max_missing_image_fraction of the exposures had an unreadable image.
+void ThrowIfTooManyUnreadable(const Survey& survey,
+                              const ReconstructionSummary& summary);
+
 // Writes trajectory_corrected.csv, poses.csv, gcp_residuals.csv,
 // bands.geojson, adjustment.json and colmap/. Draws its own progress bars
 // (tie points, then the solve).

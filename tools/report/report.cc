@@ -381,6 +381,11 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
   for (const std::string& file : data.missing_files) {
     warnings.push_back("no " + file + " in the results folder");
   }
+  if (survey.roadmarks.bands.empty()) {
+    warnings.push_back("the road-mark database (" + survey.manifest.roadmarks +
+                       ") holds no zebra band: nothing can control the "
+                       "trajectory");
+  }
   if (data.decisions.empty() || matched == 0) {
     warnings.push_back(
         "no zebra crossing was matched: the trajectory is not "

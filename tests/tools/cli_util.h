@@ -1,0 +1,64 @@
+// Helpers for tests that drive the real `zebrageo` binary.
+#ifndef ZEBRAGEO_TESTS_TOOLS_CLI_UTIL_H_
+#define ZEBRAGEO_TESTS_TOOLS_CLI_UTIL_H_
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace zebrageo {
+
+inline std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+// Runs `zebrageo ARGS` through the shell with stdout and stderr captured to
+// files. Returns the exit status, or 128 + the signal that killed it.
+inline int RunZebrageo(const std::string& args, const std::string& out_path,
+                       const std::string& err_path) {
+  const std::string command = Quote(ZEBRAGEO_BINARY) + " " + args + " >" +
+                              Quote(out_path) + " 2>" + Quote(err_path);
+  const int status = std::system(command.c_str());
+  if (status == -1) return -1;
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  // The shell reports a child killed by a signal as 128 + signal.
+  return WEXITSTATUS(status);
+}
+
+inline std::string ReadWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Every regular file under `folder`, relative to it.
+inline std::vector<std::string> FilesUnder(const std::string& folder) {
+  std::vector<std::string> files;
+  if (!std::filesystem::is_directory(folder)) return files;
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(folder)) {
+    if (entry.is_regular_file()) {
+      files.push_back(
+          std::filesystem::relative(entry.path(), folder).string());
+    }
+  }
+  return files;
+}
+
+// A small survey (80 m, 2 crossings, 640x480 images, ~20 exposures) that
+// the whole pipeline processes in a few seconds.
+inline std::string SmallSurveyArguments() {
+  return "--preset demo --seed 1 --set road_length_m=80 --set "
+         "num_crossings=2 --set num_stale_crossings=0 --set "
+         "min_crossing_spacing_m=25 --set image_width=640 --set "
+         "image_height=480 --set focal_px=560 --set supersampling=2 --set "
+         "exposure_spacing_m=4";
+}
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_TESTS_TOOLS_CLI_UTIL_H_

@@ -1,0 +1,190 @@
+// Killing the real `zebrageo run` with SIGKILL in the middle of a stage and
+// running it again gives the results of an uninterrupted run, resumes the
+// stages that were complete, and leaves no temporary file.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/survey/test_util.h"
+#include "tests/tools/cli_util.h"
+
+extern char** environ;
+
+namespace zebrageo {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::vector<std::string> kCompared = {
+    "reconstructed_bands.csv", "matches.csv",       "crossing_decisions.csv",
+    "trajectory_corrected.csv", "poses.csv",        "gcp_residuals.csv",
+    "bands.geojson"};
+
+// Numbers of a text file (comments skipped), in order; other tokens as text.
+std::vector<std::string> Tokens(const std::string& path) {
+  std::vector<std::string> tokens;
+  std::istringstream in(ReadWholeFile(path));
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] == '#') continue;  // timings in comments
+    std::string token;
+    for (char c : line) {
+      if (c == ',' || c == ' ' || c == '[' || c == ']' || c == '{' ||
+          c == '}' || c == ':') {
+        if (!token.empty()) tokens.push_back(token);
+        token.clear();
+      } else {
+        token += c;
+      }
+    }
+    if (!token.empty()) tokens.push_back(token);
+  }
+  return tokens;
+}
+
+// Same tokens; numbers equal to 1e-9 + 1e-11 relative (the multi-threaded
+// solver may differ in the last bits; a stage resumed from a wrong or
+// partial input would differ by centimetres).
+void ExpectSameResults(const std::string& a, const std::string& b) {
+  for (const std::string& file : kCompared) {
+    SCOPED_TRACE(file);
+    const std::vector<std::string> ta = Tokens(a + "/" + file);
+    const std::vector<std::string> tb = Tokens(b + "/" + file);
+    ASSERT_EQ(ta.size(), tb.size());
+    ASSERT_FALSE(ta.empty());
+    int differences = 0;
+    for (size_t i = 0; i < ta.size() && differences < 5; ++i) {
+      if (ta[i] == tb[i]) continue;
+      char* end_a = nullptr;
+      char* end_b = nullptr;
+      const double va = std::strtod(ta[i].c_str(), &end_a);
+      const double vb = std::strtod(tb[i].c_str(), &end_b);
+      const bool numbers = *end_a == '\0' && *end_b == '\0';
+      if (numbers && std::abs(va - vb) <= 1e-9 + 1e-11 * std::abs(va)) {
+        continue;
+      }
+      ++differences;
+      ADD_FAILURE() << "token " << i << ": " << ta[i] << " vs " << tb[i];
+    }
+  }
+}
+
+// Starts `zebrageo ARGS...` with stdout and stderr to /dev/null.
+pid_t Spawn(const std::vector<std::string>& args) {
+  std::vector<std::string> argv_strings = {ZEBRAGEO_BINARY};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = -1;
+  const int error =
+      posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return error == 0 ? pid : -1;
+}
+
+// True while run_state.json records `stage` as started, not complete.
+bool StageInProgress(const std::string& results, const std::string& stage) {
+  const std::string text = ReadWholeFile(results + "/run_state.json");
+  if (!json::accept(text)) return false;
+  const json state = json::parse(text);
+  return state.contains("stages") && state["stages"].contains(stage) &&
+         !state["stages"][stage].value("complete", true);
+}
+
+class RunResume : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    folder_ = new TemporaryFolder();
+    survey_ = folder_->Path("survey");
+    reference_ = folder_->Path("reference");
+    ASSERT_EQ(RunZebrageo("--log-level error simulate " +
+                              SmallSurveyArguments() + " -o " + Quote(survey_),
+                          folder_->Path("sim.out"), folder_->Path("sim.err")),
+              0)
+        << ReadWholeFile(folder_->Path("sim.err"));
+    ASSERT_EQ(RunZebrageo("--log-level error run " + Quote(survey_) + " -o " +
+                              Quote(reference_),
+                          folder_->Path("ref.out"), folder_->Path("ref.err")),
+              0)
+        << ReadWholeFile(folder_->Path("ref.err"));
+  }
+  static void TearDownTestSuite() { delete folder_; }
+
+  // Kills a run with SIGKILL `delay` after `stage` starts, reruns it, and
+  // compares with the uninterrupted reference.
+  void KillDuringStageThenRerun(const std::string& stage,
+                                std::chrono::milliseconds delay) {
+    const std::string results = folder_->Path("killed-in-" + stage);
+    const pid_t pid =
+        Spawn({"--log-level", "error", "run", survey_, "-o", results});
+    ASSERT_GT(pid, 0);
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::seconds(300);
+    while (!StageInProgress(results, stage) &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    std::this_thread::sleep_for(delay);
+    kill(pid, SIGKILL);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFSIGNALED(status))
+        << "the run ended before the kill: the test did not interrupt "
+        << stage;
+    ASSERT_TRUE(StageInProgress(results, stage)) << "killed after " << stage;
+
+    const std::string err = folder_->Path(stage + ".err");
+    ASSERT_EQ(RunZebrageo("run " + Quote(survey_) + " -o " + Quote(results),
+                          folder_->Path(stage + ".out"), err),
+              0)
+        << ReadWholeFile(err);
+    ExpectSameResults(reference_, results);
+    for (const std::string& file : FilesUnder(results)) {
+      EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+    }
+    const json report = json::parse(ReadWholeFile(results + "/report.json"));
+    const json resumed = report.at("resumed_stages");
+    EXPECT_EQ(std::find(resumed.begin(), resumed.end(), stage), resumed.end())
+        << "the killed stage was redone";
+    if (stage == "adjust") {
+      EXPECT_NE(std::find(resumed.begin(), resumed.end(), "reconstruct"),
+                resumed.end())
+          << "the stages before were resumed: " << resumed.dump();
+    }
+  }
+
+  static TemporaryFolder* folder_;
+  static std::string survey_, reference_;
+};
+
+TemporaryFolder* RunResume::folder_ = nullptr;
+std::string RunResume::survey_;
+std::string RunResume::reference_;
+
+TEST_F(RunResume, KilledDuringReconstructThenRerunGivesTheSameResults) {
+  KillDuringStageThenRerun("reconstruct", std::chrono::milliseconds(300));
+}
+
+TEST_F(RunResume, KilledDuringAdjustThenRerunGivesTheSameResults) {
+  KillDuringStageThenRerun("adjust", std::chrono::milliseconds(50));
+}
+
+}  // namespace
+}  // namespace zebrageo
