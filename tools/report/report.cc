@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
@@ -602,6 +603,56 @@ std::string ResidualPlots(const ReportData& data) {
   return html;
 }
 
+// Before/after figure of the adjustment: per observation type, the RMS of
+// the residuals before (grey) and after (blue) as bars scaled to the larger
+// of the two (the types differ by orders of magnitude and in units).
+std::string BeforeAfterFigure(const json& adjustment) {
+  if (!adjustment.is_object() || !adjustment.contains("rms")) return "";
+  constexpr int kRowPx = 44, kLabelPx = 230, kBarPx = 420, kWidthPx = 860;
+  std::ostringstream rows;
+  int n = 0;
+  for (const auto& [type, values] : adjustment["rms"].items()) {
+    if (!values.is_object() || !values.contains("before") ||
+        !values.contains("after") || !values["before"].is_number() ||
+        !values["after"].is_number()) {
+      continue;
+    }
+    const double before = values["before"].get<double>();
+    const double after = values["after"].get<double>();
+    const std::string unit = values.value("unit", "");
+    const double top = std::max({before, after, 1e-12});
+    const int y = 40 + n * kRowPx;
+    rows << "<text x='0' y='" << y + 16 << "'>" << EscapeHtml(type)
+         << "</text>";
+    int row = 0;
+    for (const auto& [value, colour, name] :
+         {std::tuple<double, const char*, const char*>{before, "#aaa",
+                                                       "before"},
+          {after, "#1f77b4", "after"}}) {
+      const int bar_y = y + row++ * 18;
+      const double w = std::max(1.0, kBarPx * value / top);
+      rows << "<rect x='" << kLabelPx << "' y='" << bar_y << "' width='"
+           << Fixed(w, 1) << "' height='14' fill='" << colour
+           << "'/><text x='" << kLabelPx + w + 6 << "' y='" << bar_y + 11
+           << "'>" << name << " " << Fixed(value, 3) << " "
+           << EscapeHtml(unit) << "</text>";
+    }
+    rows << "\n";
+    ++n;
+  }
+  if (n == 0) return "";
+  std::ostringstream svg;
+  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kWidthPx
+      << "' height='" << 50 + n * kRowPx << "' viewBox='0 0 " << kWidthPx
+      << " " << 50 + n * kRowPx
+      << "' font-family='sans-serif' font-size='11'>\n"
+      << "<text x='" << kWidthPx / 2
+      << "' y='16' text-anchor='middle' font-size='14' font-weight='bold'>"
+      << "Residual RMS before and after the adjustment</text>\n"
+      << rows.str() << "</svg>\n";
+  return svg.str();
+}
+
 std::string RenderHtml(const json& report, const ReportData& data) {
   std::ostringstream html;
   const std::string name = report["survey"]["name"].get<std::string>();
@@ -650,7 +701,7 @@ std::string RenderHtml(const json& report, const ReportData& data) {
     }
     html << "<p>RMS of the residuals per observation type, before and after "
             "the adjustment:</p>\n"
-         << ArrayTable(rms);
+         << ArrayTable(rms) << BeforeAfterFigure(report["adjustment"]);
   }
   if (report.contains("corrections")) {
     html << "<p>Corrections applied to the trajectory:</p>\n"

@@ -11,14 +11,23 @@ namespace zebrageo {
 namespace {
 
 constexpr int kMarginLeft = 70;
+// Smallest right margin; it grows to fit the legend (RightMargin).
 constexpr int kMarginRight = 90;
+// Width of a character of the 11 px sans-serif text, generously: the
+// legend must not be clipped by the SVG's right edge.
+constexpr double kCharWidthPx = 6.6;
 constexpr int kMarginTop = 44;
 constexpr int kMarginBottom = 48;
 
 std::string Number(double value, int decimals = 2) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  return buffer;
+  // A tick at -1e-17 is zero, not "-0".
+  const std::string text = buffer;
+  if (text.find_first_not_of("-0.") == std::string::npos && text[0] == '-') {
+    return text.substr(1);
+  }
+  return text;
 }
 
 // "Nice" tick spacing (1, 2, 5 x 10^k) giving about `count` ticks.
@@ -126,7 +135,22 @@ void SvgPlot::SetColourScale(double min_value, double max_value,
   colour_label_ = std::move(label);
 }
 
+int SvgPlot::RightMargin() const {
+  double legend_px = 0.0;
+  for (const PlotSeries& s : series_) {
+    if (!s.label.empty()) {
+      legend_px = std::max(legend_px, 14.0 + kCharWidthPx * s.label.size());
+    }
+  }
+  if (has_colour_scale_) {
+    legend_px =
+        std::max(legend_px, kCharWidthPx * colour_label_.size());
+  }
+  return std::max(kMarginRight, static_cast<int>(std::ceil(legend_px)) + 16);
+}
+
 std::string SvgPlot::Render() const {
+  const int margin_right = RightMargin();
   Range xr, yr;
   for (const PlotSeries& s : series_) {
     for (double v : s.x) xr.Add(v);
@@ -140,7 +164,7 @@ std::string SvgPlot::Render() const {
   }
   xr.Pad();
   yr.Pad();
-  const double plot_w = width_px_ - kMarginLeft - kMarginRight;
+  const double plot_w = width_px_ - kMarginLeft - margin_right;
   const double plot_h = height_px_ - kMarginTop - kMarginBottom;
   if (equal_aspect_) {
     // Grow the smaller span so one metre is as long on both axes.
@@ -248,7 +272,7 @@ std::string SvgPlot::Render() const {
   int legend_y = kMarginTop + 6;
   for (const PlotSeries& s : series_) {
     if (s.label.empty()) continue;
-    const int x = width_px_ - kMarginRight + 8;
+    const int x = width_px_ - margin_right + 8;
     svg << "<rect x='" << x << "' y='" << legend_y << "' width='10' "
         << "height='10' fill='" << s.colour << "'/><text x='" << x + 14
         << "' y='" << legend_y + 9 << "'>" << EscapeHtml(s.label)
@@ -256,7 +280,7 @@ std::string SvgPlot::Render() const {
     legend_y += 16;
   }
   if (has_colour_scale_) {
-    const int x = width_px_ - kMarginRight + 8;
+    const int x = width_px_ - margin_right + 8;
     const int top = legend_y + 10, height = 100;
     for (int i = 0; i < 20; ++i) {
       svg << "<rect x='" << x << "' y='" << top + height - (i + 1) * 5

@@ -41,6 +41,8 @@ class SvgPlot {
   std::string Render() const;
 
  private:
+  // Right margin wide enough for the legend and the colour scale's label.
+  int RightMargin() const;
   std::string title_, x_label_, y_label_, note_;
   int width_px_, height_px_;
   std::vector<PlotSeries> series_;
