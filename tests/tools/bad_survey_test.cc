@@ -6,6 +6,8 @@
 // leaves no output; a usable one exits 0 with every output and a warning).
 // Then ../shared/tools/score_results.py badinput, the independent checker,
 // judges the same folder when it is present.
+#include "tools/simulator/bad_survey.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,7 +23,6 @@
 
 #include "tests/survey/test_util.h"
 #include "tests/tools/cli_util.h"
-#include "tools/simulator/bad_survey.h"
 
 namespace zebrageo {
 
@@ -37,9 +38,9 @@ using nlohmann::json;
 
 // What the results folder of SURVEY_FORMAT.md holds (score_results.py's
 // OUTPUTS).
-const std::vector<std::string> kOutputs = {
-    "trajectory_corrected.csv", "poses.csv", "bands.geojson",
-    "gcp_residuals.csv", "report.json"};
+const std::vector<std::string> kOutputs = {"trajectory_corrected.csv",
+                                           "poses.csv", "bands.geojson",
+                                           "gcp_residuals.csv", "report.json"};
 
 // Per kind: what stderr's last line must say (file, line where the fault has
 // one, problem) or, for a usable survey, what a warning of report.json must
@@ -54,10 +55,12 @@ const std::map<std::string, std::string>& ExpectedMessages() {
        R"(exposures\.csv: [0-9]+ of [0-9]+ exposures have an unreadable image.*images/[0-9]+_left\.png: cannot decode)"},
       {"missing_images",
        R"(images are missing.*exposures\.csv:[0-9]+: image images/[0-9]+_left\.png does not exist)"},
-      {"missing_rig", R"(survey\.yaml:[0-9]+: 'rig' names rig\.yaml, which does not exist)"},
+      {"missing_rig",
+       R"(survey\.yaml:[0-9]+: 'rig' names rig\.yaml, which does not exist)"},
       {"exposures_outside",
        R"(exposures\.csv:[0-9]+: exposure [0-9]+ at time [0-9.]+ is outside the trajectory's span)"},
-      {"bad_focal", R"(rig\.yaml:[0-9]+: camera 'left' K: fx and fy must be > 0)"},
+      {"bad_focal",
+       R"(rig\.yaml:[0-9]+: camera 'left' K: fx and fy must be > 0)"},
       {"bad_rotation",
        R"(rig\.yaml:[0-9]+: camera 'left' T_body_cam: rotation is not orthonormal)"},
       {"bad_matrix",
@@ -102,8 +105,8 @@ void ExpectNothingPartial(const std::string& results) {
       for (std::string line; std::getline(in, line);) {
         ++line_number;
         if (line.empty() || line[0] == '#') continue;
-        const int fields = 1 + static_cast<int>(std::count(
-                                   line.begin(), line.end(), ','));
+        const int fields =
+            1 + static_cast<int>(std::count(line.begin(), line.end(), ','));
         if (header_fields < 0) header_fields = fields;
         ASSERT_EQ(fields, header_fields) << "line " << line_number;
       }
@@ -147,10 +150,9 @@ TEST_P(BadSurvey, RunEndsCleanlyAsExpected) {
       << "the simulator's fields are kept";
 
   const std::string err_path = folder.Path("run.err");
-  const int code =
-      RunZebrageo("--log-level warning run " + Quote(survey) + " -o " +
-                      Quote(results) + " --threads 2",
-                  folder.Path("run.out"), err_path);
+  const int code = RunZebrageo("--log-level warning run " + Quote(survey) +
+                                   " -o " + Quote(results) + " --threads 2",
+                               folder.Path("run.out"), err_path);
   const std::string err = ReadWholeFile(err_path);
   SCOPED_TRACE("stderr:\n" + err);
   // A message may quote the bad value ("nan"), never print a computed one.
@@ -224,8 +226,9 @@ TEST(BadSurveyKinds, UnknownKindIsAUsageError) {
   EXPECT_EQ(RunZebrageo("simulate --bad nope -o " + Quote(folder.Path("s")),
                         folder.Path("out"), folder.Path("err")),
             2);
-  EXPECT_TRUE(Contains(ReadWholeFile(folder.Path("err")),
-                       "--bad nope: not a kind \\(kinds: truncated_trajectory"));
+  EXPECT_TRUE(
+      Contains(ReadWholeFile(folder.Path("err")),
+               "--bad nope: not a kind \\(kinds: truncated_trajectory"));
   EXPECT_FALSE(fs::exists(folder.Path("s")));
 }
 

@@ -42,8 +42,7 @@ inline std::vector<std::string> FilesUnder(const std::string& folder) {
   for (const auto& entry :
        std::filesystem::recursive_directory_iterator(folder)) {
     if (entry.is_regular_file()) {
-      files.push_back(
-          std::filesystem::relative(entry.path(), folder).string());
+      files.push_back(std::filesystem::relative(entry.path(), folder).string());
     }
   }
   return files;

@@ -28,10 +28,13 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const std::vector<std::string> kCompared = {
-    "reconstructed_bands.csv", "matches.csv",       "crossing_decisions.csv",
-    "trajectory_corrected.csv", "poses.csv",        "gcp_residuals.csv",
-    "bands.geojson"};
+const std::vector<std::string> kCompared = {"reconstructed_bands.csv",
+                                            "matches.csv",
+                                            "crossing_decisions.csv",
+                                            "trajectory_corrected.csv",
+                                            "poses.csv",
+                                            "gcp_residuals.csv",
+                                            "bands.geojson"};
 
 // Numbers of a text file (comments skipped), in order; other tokens as text.
 std::vector<std::string> Tokens(const std::string& path) {

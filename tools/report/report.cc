@@ -632,10 +632,9 @@ std::string BeforeAfterFigure(const json& adjustment) {
       const int bar_y = y + row++ * 18;
       const double w = std::max(1.0, kBarPx * value / top);
       rows << "<rect x='" << kLabelPx << "' y='" << bar_y << "' width='"
-           << Fixed(w, 1) << "' height='14' fill='" << colour
-           << "'/><text x='" << kLabelPx + w + 6 << "' y='" << bar_y + 11
-           << "'>" << name << " " << Fixed(value, 3) << " "
-           << EscapeHtml(unit) << "</text>";
+           << Fixed(w, 1) << "' height='14' fill='" << colour << "'/><text x='"
+           << kLabelPx + w + 6 << "' y='" << bar_y + 11 << "'>" << name << " "
+           << Fixed(value, 3) << " " << EscapeHtml(unit) << "</text>";
     }
     rows << "\n";
     ++n;
@@ -643,9 +642,8 @@ std::string BeforeAfterFigure(const json& adjustment) {
   if (n == 0) return "";
   std::ostringstream svg;
   svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kWidthPx
-      << "' height='" << 50 + n * kRowPx << "' viewBox='0 0 " << kWidthPx
-      << " " << 50 + n * kRowPx
-      << "' font-family='sans-serif' font-size='11'>\n"
+      << "' height='" << 50 + n * kRowPx << "' viewBox='0 0 " << kWidthPx << " "
+      << 50 + n * kRowPx << "' font-family='sans-serif' font-size='11'>\n"
       << "<text x='" << kWidthPx / 2
       << "' y='16' text-anchor='middle' font-size='14' font-weight='bold'>"
       << "Residual RMS before and after the adjustment</text>\n"

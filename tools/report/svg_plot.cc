@@ -143,8 +143,7 @@ int SvgPlot::RightMargin() const {
     }
   }
   if (has_colour_scale_) {
-    legend_px =
-        std::max(legend_px, kCharWidthPx * colour_label_.size());
+    legend_px = std::max(legend_px, kCharWidthPx * colour_label_.size());
   }
   return std::max(kMarginRight, static_cast<int>(std::ceil(legend_px)) + 16);
 }
