@@ -267,6 +267,8 @@ struct BandCandidate {
   // deviation of that inferred side across the band.
   int inferred = -1;
   double inferred_sigma_m = 0.0;
+  // A lone long side runs between its two sides.
+  bool edge_between = false;
 };
 
 // The transversal side of a band end taken from its crossing (hidden end).
@@ -824,6 +826,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       }
       if (first_end < last_start) continue;
       BandCandidate c;
+      c.edge_between = first_end < 1e30 || last_start > -1e30;
       c.lo = i;
       c.hi = j;
       c.begin = std::max(a0, b0);
@@ -844,6 +847,30 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     if (side_used[c.lo] || side_used[c.hi]) continue;
     side_used[c.lo] = side_used[c.hi] = 1;
     pairs.push_back(c);
+  }
+  // A band with an edge along it (a shadow boundary, or a lane line and its
+  // kerb lit between two shadows) is kept only beside other bands of a
+  // crossing.
+  {
+    std::vector<BandCandidate> kept;
+    for (const BandCandidate& c : pairs) {
+      int neighbours = 0;
+      const LongSide& a = sides[c.lo];
+      const double centre = 0.5 * (a.lateral_m + sides[c.hi].lateral_m);
+      for (const BandCandidate& o : pairs) {
+        const LongSide& b = sides[o.lo];
+        if (o.edge_between || b.direction_set != a.direction_set) continue;
+        const double other = 0.5 * (b.lateral_m + sides[o.hi].lateral_m);
+        if (&o != &c &&
+            std::abs(other - centre) <=
+                options.max_crossing_gap_m + 2.0 * zebra.band_width_m &&
+            std::min(c.end, o.end) - std::max(c.begin, o.begin) > 0.0) {
+          ++neighbours;
+        }
+      }
+      if (!c.edge_between || neighbours >= 2) kept.push_back(c);
+    }
+    pairs.swap(kept);
   }
   if (debug != nullptr) {
     for (const BandCandidate& c : pairs) {
@@ -1291,6 +1318,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   // band next to them. The band's seen end must lie on the other line.
   std::vector<std::array<PlaneLine, 2>> lines(crossings);
   std::vector<std::array<double, 2>> line_sigma(crossings, {-1.0, -1.0});
+  std::vector<std::array<double, 2>> line_rms(crossings, {-1.0, -1.0});
   std::vector<std::array<double, 2>> lateral_range(crossings, {1e30, -1e30});
   for (int c = 0; c < crossings; ++c) {
     for (int e = 0; e < 2; ++e) {
@@ -1318,6 +1346,9 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       }
       const double rms =
           std::sqrt(sum_squares / static_cast<double>(points.size() - 2));
+      VLOG(2) << "crossing " << c << " end " << e << ": line through "
+              << points.size() / 2 << " bands, rms " << rms;
+      line_rms[c][e] = rms;
       if (rms <= options.hidden_end_max_rms_m) {
         line_sigma[c][e] = std::max(options.completion_min_sigma_m, 2.0 * rms);
       }
@@ -1325,7 +1356,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   }
   for (int i : without_transversal) {
     const int c = crossing_of[i];
-    if (line_sigma[c][0] < 0.0 || line_sigma[c][1] < 0.0) continue;
+    if (line_rms[c][0] < 0.0 || line_rms[c][1] < 0.0) continue;
     // Next to the seen bands: at most one band period out of them.
     const LongSide& lo = sides[pairs[i].lo];
     const LongSide& hi = sides[pairs[i].hi];
@@ -1338,6 +1369,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       continue;
     }
     for (int e = 0; e < 2; ++e) {
+      if (line_sigma[c][e] < 0.0) continue;  // not reliable
       KnownEnd known[2];
       known[e].line = &lines[c][e];
       known[e].sigma_m = line_sigma[c][e];
@@ -1354,7 +1386,10 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       }
       VLOG(2) << "band " << i << ": hidden end " << e << ", seen end "
               << worst << " m off the crossing's line";
-      if (worst > options.hidden_end_max_offset_m) continue;
+      if (worst > std::max(options.hidden_end_max_offset_m,
+                           3.0 * line_rms[c][1 - e])) {
+        continue;
+      }
       bands.push_back(band);
       break;
     }

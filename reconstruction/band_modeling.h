@@ -87,7 +87,8 @@ struct BandOptions {
   // band, the line through that end's vertices of the crossing's fully
   // seen bands (at least completion_min_bands, residual rms at most
   // hidden_end_max_rms_m) gives it; the band's seen end must then lie
-  // within hidden_end_max_offset_m of the crossing's other line. The
+  // within hidden_end_max_offset_m (or 3 rms) of the crossing's other line.
+  // The
   // inferred end's standard deviation along the band is twice that rms, at
   // least completion_min_sigma_m.
   bool infer_hidden_ends = true;
