@@ -301,6 +301,46 @@ void Extent(const PlaneFrame& frame, const LongSide& side,
 }
 
 
+// How far a transversal edge runs on beyond the band: the mean gradient
+// across `line` (with its polarity) beyond the band's long sides, from 10 %
+// to 50 % of the band width outside `ends` (the image vertices; `check`
+// says which side to look beyond), over the mean along the middle of the
+// band's end. About 0 for a band's painted end, much more for a shadow
+// boundary crossing the road. 0 when nothing beyond can be sampled.
+double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
+                        const Eigen::Vector2d ends[2], const bool check[2]) {
+  if (!(line.gamma.norm() > 0.0)) return 0.0;
+  const Eigen::Vector2d polarity = line.gamma.normalized();
+  const Eigen::Vector2d span = ends[1] - ends[0];
+  const double width = span.norm();
+  if (!(width > 2.0)) return 0.0;
+  const Eigen::Vector2d unit = span / width;
+  auto mean_between = [&](const Eigen::Vector2d& from, double t0, double t1,
+                          const Eigen::Vector2d& direction) {
+    double sum = 0.0;
+    int count = 0;
+    for (double t = t0; t <= t1; t += 1.0) {
+      const Eigen::Vector2d p = from + t * direction;
+      if (!edges.IsUsable(p.x(), p.y())) continue;
+      const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
+      sum += polarity.x() * g[0] + polarity.y() * g[1];
+      ++count;
+    }
+    return count >= 3 ? sum / count : std::nan("");
+  };
+  const double inside =
+      mean_between(ends[0], 0.2 * width, 0.8 * width, unit);
+  if (!(inside > 0.0)) return 0.0;
+  double run_on = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    if (!check[k]) continue;
+    const double outside = mean_between(ends[k], 0.1 * width, 0.5 * width,
+                                        k == 0 ? Eigen::Vector2d(-unit) : unit);
+    if (std::isfinite(outside)) run_on = std::max(run_on, outside / inside);
+  }
+  return run_on;
+}
+
 // Completes the crossings: a long side that no band took, lying where the
 // crossing's regular pattern expects a band side (one band width from the
 // slot of a missing band, with the polarity of that side), becomes a band
@@ -535,6 +575,9 @@ std::string BandOptions::Check() const {
   } else if (!(inferred_score_factor > 0.0 && inferred_score_factor <= 1.0)) {
     error << "inferred_score_factor = " << inferred_score_factor
           << ": must be in (0, 1]";
+  } else if (!(max_transversal_run_on > 0.0)) {
+    error << "max_transversal_run_on = " << max_transversal_run_on
+          << ": must be > 0";
   } else if (!(hidden_end_max_rms_m > 0.0)) {
     error << "hidden_end_max_rms_m = " << hidden_end_max_rms_m
           << ": must be > 0";
@@ -1193,6 +1236,30 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
         }
       }
       if (failed) break;
+      // A seen transversal edge stops at the long sides: a shadow boundary
+      // across a lane line runs on over the road.
+      for (int e = 0; e < 2 && !failed; ++e) {
+        if (known[e].line != nullptr) continue;
+        Eigen::Vector2d ends[2];
+        if (!Intersect(long_lines[0], transversal_lines[e], &ends[0]) ||
+            !Intersect(long_lines[1], transversal_lines[e], &ends[1])) {
+          failed = true;
+          break;
+        }
+        // Beyond a hidden long side, what hides it may have edges.
+        const bool check[2] = {pairs[i].inferred != 0,
+                               pairs[i].inferred != 1};
+        const double run_on =
+            TransversalRunOn(edges[side], transversal_lines[e], ends, check);
+        VLOG(2) << "band " << i << " side " << side << " end " << e
+                << ": run-on " << run_on;
+        failed = run_on > options.max_transversal_run_on;
+      }
+      if (failed) {
+        VLOG(2) << "band " << i << " side " << side
+                << ": a transversal edge runs on beyond the band";
+        break;
+      }
       for (int v = 0; v < 4; ++v) vertex_sum[v] += vertex_side[side][v];
       ++views;
     }

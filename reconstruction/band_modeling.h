@@ -55,6 +55,11 @@ struct BandOptions {
   // within this distance, at least this many along it.
   double refine_distance_px = 6.0;
   int min_transversal_points = 8;
+  // The gradient across a seen transversal side beyond the long sides must
+  // stay below this share of the one along the band's end: a shadow
+  // boundary across a lane line runs on over the road, a painted end does
+  // not.
+  double max_transversal_run_on = 0.6;
   // The left and right images give two estimates of each vertex; a band
   // whose estimates differ by more is dropped.
   double max_stereo_disagreement_m = 0.05;
