@@ -413,8 +413,17 @@ class AdjustmentProblem {
     Eigen::Matrix<double, 6, 6> S_rate = Eigen::Matrix<double, 6, 6>::Zero();
     S_rate.diagonal().head<3>().setConstant(
         1.0 / (options_.drift_rate_sigma_deg_per_s * kDegToRad * dt));
-    S_rate.diagonal().tail<3>().setConstant(
-        1.0 / (options_.drift_rate_sigma_mps * dt));
+    // A drift of sigma correlated over tau (first-order Gauss-Markov) changes
+    // by sigma sqrt(2 dt / tau) per dt: a small drift is a slow one too, so
+    // the correction cannot make a local bump at each crossing either.
+    const double tau = options_.prior_correlation_time_s;
+    const Eigen::Vector2d rate_sigma =
+        (state_->gnss_sigma_m * std::sqrt(2.0 / (tau * dt)))
+            .cwiseMin(options_.drift_rate_sigma_mps);
+    S_rate.diagonal().tail<3>() =
+        Eigen::Vector3d(1.0 / rate_sigma.x(), 1.0 / rate_sigma.x(),
+                        1.0 / rate_sigma.y()) /
+        dt;
     Eigen::Matrix<double, 6, 6> S_acc = Eigen::Matrix<double, 6, 6>::Zero();
     S_acc.diagonal().head<3>().setConstant(
         1.0 / (options_.drift_angular_acceleration_sigma_deg_per_s2 *
