@@ -14,17 +14,25 @@
 //   - the database position of each control vertex (sigma_xy, sigma_z of
 //     the database) plus its crossing's offset (crossing_offset_sigma_m),
 //     Cauchy loss;
-//   - the GNSS/INS solution: the correction at each knot is 0 +- gnss_*
-//     (Cauchy loss: a GNSS jump is an outlier, not a constraint);
-//   - the INS relative motion: the drift rate (first difference of knots)
-//     and its change (second difference) are small; their sigmas set how
-//     fast the correction may vary between control points.
+//   - the GNSS/INS solution: the correction at each knot is 0 +- gnss_*,
+//     counted once per prior_correlation_time_s (Cauchy loss: a GNSS jump
+//     is an outlier, not a constraint); gnss_* are estimated from the
+//     control first (variance components: what the crossings' discrepancies
+//     hold beyond the database's own error), so a drift smaller than the
+//     database's error is not "corrected" into that error;
+//   - the INS relative motion: the drift rate (first difference of knots,
+//     at most what a Gauss-Markov drift of sigma gnss_* and correlation
+//     time prior_correlation_time_s allows) and its change (second
+//     difference) are small; they set how fast the correction may vary
+//     between control points.
 // Solved with Ceres (SPARSE_SCHUR on SuiteSparse: points eliminated, the
 // banded knot system factorised), first without robust losses to take out
 // the drift, then robustly; then control vertices whose image-only position
 // disagrees with the database (normalised residual above
 // blunder_threshold) are removed and the adjustment repeated. A share of
-// crossings is held out as check points: evaluated, never adjusted.
+// crossings is held out as check points: their residuals come from an
+// adjustment without them; the final adjustment then uses them as control
+// (check_points_in_final).
 #ifndef ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 #define ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 
