@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git clang libclang-rt-14-dev
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
-  libopencv-dev libgeographiclib-dev
+  libopencv-dev libopencv-contrib-dev libgeographiclib-dev
   libyaml-cpp-dev nlohmann-json3-dev libsimdjson-dev libcli11-dev libbz2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev

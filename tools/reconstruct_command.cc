@@ -27,6 +27,7 @@ struct ReconstructArguments {
   double ground_pixel_m = ReconstructionOptions().rectification.ground_pixel_m;
   double min_long_side_length_m =
       ReconstructionOptions().long_sides.min_long_side_length_m;
+  bool lines = false;  // also the road lines (issue 9)
 };
 
 ReconstructionOptions OptionsFrom(const ReconstructArguments& args) {
@@ -47,8 +48,16 @@ void RunReconstruct(const ReconstructArguments& args) {
   load_options.load_roadmarks = false;
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
   ProgressBar bar("reconstruct");
-  RunReconstructStage(survey, options, args.stage.results, bar.Callback());
+  RoadPlane road_plane;
+  RunReconstructStage(survey, options, args.stage.results, bar.Callback(),
+                      &road_plane);
   bar.Finish();
+  if (args.lines) {
+    ProgressBar lines_bar("road lines");
+    RunRoadLinesStage(survey, road_plane, RoadLineOptions(), args.threads,
+                      args.stage.results, lines_bar.Callback());
+    lines_bar.Finish();
+  }
 }
 
 }  // namespace
@@ -56,12 +65,13 @@ void RunReconstruct(const ReconstructArguments& args) {
 std::vector<std::string> RunReconstructStage(
     const Survey& survey, const ReconstructionOptions& options,
     const std::string& results_folder,
-    const std::function<void(int, int)>& progress) {
+    const std::function<void(int, int)>& progress, RoadPlane* road_plane) {
   std::filesystem::create_directories(results_folder);
   std::vector<ReconstructedVertex> vertices;
   const ReconstructionSummary summary =
       ReconstructSurvey(survey, options, &vertices, progress);
   if (!summary.IsUsable()) throw StageFailedError(summary.message);
+  if (road_plane != nullptr) *road_plane = summary.final_road_plane;
 
   StepTimings mean = summary.timings;
   const double n = std::max(1, summary.pairs_processed);
@@ -94,7 +104,8 @@ void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands) {
   CLI::App* sub =
       AddStageSubcommand(app, "reconstruct",
                          "Reconstruct the zebra bands of every stereo pair in "
-                         "3D; writes reconstructed_bands.csv.",
+                         "3D; writes reconstructed_bands.csv (and "
+                         "reconstructed_lines.csv with --lines).",
                          &args->stage);
   sub->add_option("--threads", args->threads,
                   "worker threads (0: one per hardware thread)")
@@ -112,6 +123,9 @@ void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--min-side-length", args->min_long_side_length_m,
                   "L_min: shortest long side of a band kept, metres")
       ->capture_default_str();
+  sub->add_flag("--lines", args->lines,
+                "also extract the lane and stop lines in 3D "
+                "(reconstructed_lines.csv)");
   commands->push_back({sub, [args] { RunReconstruct(*args); }});
 }
 

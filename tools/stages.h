@@ -10,13 +10,24 @@
 
 #include "adjustment/trajectory_adjuster.h"
 #include "reconstruction/reconstruction.h"
+#include "reconstruction/road_lines.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
 
-// Writes reconstructed_bands.csv.
+// Writes reconstructed_bands.csv. `road_plane`, if given, receives the
+// road plane in the body frame as the stage estimated it.
 std::vector<std::string> RunReconstructStage(
     const Survey& survey, const ReconstructionOptions& options,
+    const std::string& results_folder,
+    const std::function<void(int, int)>& progress,
+    RoadPlane* road_plane = nullptr);
+
+// Writes reconstructed_lines.csv (road lines, issue 9) using the road plane
+// of the zebra stage.
+std::vector<std::string> RunRoadLinesStage(
+    const Survey& survey, const RoadPlane& road_plane,
+    const RoadLineOptions& options, int threads,
     const std::string& results_folder,
     const std::function<void(int, int)>& progress);
 

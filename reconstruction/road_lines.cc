@@ -1,0 +1,747 @@
+#include "reconstruction/road_lines.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <ctime>
+#include <mutex>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc.hpp>
+#include <sstream>
+#include <thread>
+
+#include "survey/atomic_file.h"
+#include "survey/csv.h"
+#include "survey/image_io.h"
+
+namespace zebrageo {
+namespace {
+
+// CPU time of the calling thread (see reconstruction.cc).
+double ThreadCpuSeconds() {
+  timespec now;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return now.tv_sec + 1e-9 * now.tv_nsec;
+}
+
+bool IsSet(const cv::Mat& mask, int x, int y) {
+  return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows &&
+         mask.at<uint8_t>(y, x) != 0;
+}
+
+// True when every pixel within `radius` of p is valid: the end of a chain
+// there is the end of the painted line, not of the image.
+bool InsideValid(const cv::Mat& valid, const cv::Point& p, int radius) {
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      if (!IsSet(valid, p.x + dx, p.y + dy)) return false;
+    }
+  }
+  return true;
+}
+
+// Step 1 finds marks running across the scan lines (the rows): a chain
+// must too, its ends at least twice as far apart across the rows as along
+// them. Noise elongated along the rows (far away, one original pixel
+// covers several rectified ones along the road) is dropped.
+bool RunsAcrossRows(const std::vector<cv::Point>& chain) {
+  const cv::Point d = chain.back() - chain.front();
+  return std::abs(d.y) >= 2 * std::abs(d.x);
+}
+
+// A triangulated chain pixel.
+struct ChainPoint {
+  int index = 0;  // in the chain
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+// Step 6: the points within half_window chain pixels of each kept index,
+// averaged. Centres of neighbouring pixels are correlated over
+// correlation_px pixels, so n points count as n / correlation_px.
+void AverageVertices(const std::vector<ChainPoint>& points,
+                     const std::vector<int>& kept,
+                     const RoadLineOptions& options, RoadLine3d* line) {
+  size_t begin = 0;
+  for (int k : kept) {
+    while (begin < points.size() &&
+           points[begin].index < k - options.vertex_half_window_px) {
+      ++begin;
+    }
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    int n = 0;
+    for (size_t j = begin; j < points.size() &&
+                           points[j].index <= k + options.vertex_half_window_px;
+         ++j) {
+      sum += points[j].p;
+      covariance += points[j].covariance;
+      ++n;
+    }
+    if (n < options.min_vertex_points) continue;
+    const double effective = std::max(1.0, n / options.correlation_px);
+    line->points_body.push_back(sum / n);
+    line->covariances_body.push_back(covariance / n / effective);
+  }
+}
+
+double PolylineLength(const std::vector<Eigen::Vector3d>& points) {
+  double length = 0.0;
+  for (size_t i = 1; i < points.size(); ++i) {
+    length += (points[i] - points[i - 1]).norm();
+  }
+  return length;
+}
+
+void ParallelFor(int count, int threads, const std::function<void(int)>& work) {
+  threads = std::max(1, std::min(threads, count));
+  if (threads == 1) {
+    for (int k = 0; k < count; ++k) work(k);
+    return;
+  }
+  std::atomic<int> next{0};
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&] {
+      for (int k = next++; k < count; k = next++) work(k);
+    });
+  }
+  for (std::thread& thread : pool) thread.join();
+}
+
+}  // namespace
+
+std::string RoadLineOptions::Check() const {
+  std::ostringstream e;
+  if (!(ground_pixel_m > 0.002 && ground_pixel_m < 0.2)) {
+    e << "ground_pixel_m must be in (0.002, 0.2) m";
+  } else if (!(max_range_m > 1.0) || !(max_lateral_m > 0.5)) {
+    e << "max_range_m must exceed 1 m and max_lateral_m 0.5 m";
+  } else if (median_window_px < 1 || median_window_px % 2 == 0) {
+    e << "median_window_px must be odd and positive";
+  } else if (!(threshold_sigmas > 0.0)) {
+    e << "threshold_sigmas must be positive";
+  } else if (!(min_line_width_m > 0.0 && max_line_width_m > min_line_width_m)) {
+    e << "need 0 < min_line_width_m < max_line_width_m";
+  } else if (!(min_stop_line_width_m > 0.0 &&
+               max_stop_line_width_m > min_stop_line_width_m)) {
+    e << "need 0 < min_stop_line_width_m < max_stop_line_width_m";
+  } else if (!(max_side_difference > 0.0)) {
+    e << "max_side_difference must be positive";
+  } else if (min_chain_px < 2) {
+    e << "min_chain_px must be at least 2";
+  } else if (!(min_stop_line_length_m >= 0.0)) {
+    e << "min_stop_line_length_m must not be negative";
+  } else if (!(collinear_tolerance_px > 0.0) ||
+             !(max_vertex_spacing_m > ground_pixel_m)) {
+    e << "collinear_tolerance_px must be positive and max_vertex_spacing_m "
+         "larger than a pixel";
+  } else if (!(max_height_off_road_m > 0.0)) {
+    e << "max_height_off_road_m must be positive";
+  } else if (!(centre_sigma_px > 0.0) || !(correlation_px >= 1.0)) {
+    e << "centre_sigma_px must be positive and correlation_px at least 1";
+  } else if (vertex_half_window_px < 0 || min_vertex_points < 1) {
+    e << "vertex_half_window_px must not be negative, min_vertex_points "
+         "positive";
+  } else if (!(max_dash_length_m > 0.0)) {
+    e << "max_dash_length_m must be positive";
+  } else if (!(stop_line_height_sigma_m > 0.0)) {
+    e << "stop_line_height_sigma_m must be positive";
+  }
+  const std::string error = e.str();
+  return error.empty() ? error : "road line options: " + error;
+}
+
+cv::Mat BrightLinePixels(const cv::Mat& image, const cv::Mat& valid,
+                         int median_window_px, double threshold_sigmas,
+                         bool plain_statistics) {
+  CV_Assert(image.type() == CV_32F);
+  CV_Assert(valid.empty() ||
+            (valid.type() == CV_8U && valid.size() == image.size()));
+  cv::Mat out = cv::Mat::zeros(image.size(), CV_8U);
+  const int half = median_window_px / 2;
+  std::vector<float> values;
+  values.reserve(image.cols);
+  for (int y = 0; y < image.rows; ++y) {
+    const float* row = image.ptr<float>(y);
+    const uint8_t* ok = valid.empty() ? nullptr : valid.ptr<uint8_t>(y);
+    // The scan line's statistics. Robust (median and 1.4826 x median
+    // absolute deviation) unless plain_statistics: the paint of zebra bands
+    // crossing the scan line would otherwise raise the mean and deviation,
+    // and the threshold above the line sought.
+    values.clear();
+    for (int x = 0; x < image.cols; ++x) {
+      if (ok == nullptr || ok[x] != 0) values.push_back(row[x]);
+    }
+    const int n = static_cast<int>(values.size());
+    if (n < median_window_px) continue;
+    double mean = 0.0, sigma = 0.0;
+    if (plain_statistics) {
+      double sum = 0.0, sum2 = 0.0;
+      for (float v : values) {
+        sum += v;
+        sum2 += static_cast<double>(v) * v;
+      }
+      mean = sum / n;
+      sigma = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+    } else {
+      auto mid = values.begin() + n / 2;
+      std::nth_element(values.begin(), mid, values.end());
+      mean = *mid;
+      for (float& v : values) v = std::abs(v - static_cast<float>(mean));
+      std::nth_element(values.begin(), mid, values.end());
+      sigma = 1.4826 * *mid;
+    }
+    if (!(sigma > 0.0)) continue;
+    const double threshold = mean + threshold_sigmas * sigma;
+    // The median of the window exceeds the threshold exactly when more than
+    // half of the window does: a sliding count, no sorting.
+    uint8_t* o = out.ptr<uint8_t>(y);
+    int above = 0, invalid = 0;
+    for (int x = 0; x < image.cols + half; ++x) {
+      if (x < image.cols) {
+        above += row[x] > threshold;
+        invalid += ok != nullptr && ok[x] == 0;
+      }
+      const int leaving = x - median_window_px;
+      if (leaving >= 0) {
+        above -= row[leaving] > threshold;
+        invalid -= ok != nullptr && ok[leaving] == 0;
+      }
+      const int centre = x - half;
+      if (centre < half || centre + half >= image.cols) continue;
+      if (invalid == 0 && above > half) o[centre] = 255;
+    }
+  }
+  return out;
+}
+
+int KeepRunsByWidth(const cv::Mat& valid, int min_px, int max_px,
+                    cv::Mat* binary) {
+  CV_Assert(binary->type() == CV_8U);
+  int wide = 0;
+  for (int y = 0; y < binary->rows; ++y) {
+    uint8_t* row = binary->ptr<uint8_t>(y);
+    int x = 0;
+    while (x < binary->cols) {
+      if (row[x] == 0) {
+        ++x;
+        continue;
+      }
+      const int begin = x;
+      while (x < binary->cols && row[x] != 0) ++x;
+      const int width = x - begin;
+      const bool bounded = (valid.empty() && begin > 0 && x < binary->cols) ||
+                           (IsSet(valid, begin - 1, y) && IsSet(valid, x, y));
+      if (width > max_px && bounded) ++wide;
+      if (!bounded || width < min_px || width > max_px) {
+        std::fill(row + begin, row + x, 0);
+      }
+    }
+  }
+  return wide;
+}
+
+int KeepRunsOnEvenGround(const cv::Mat& image, double max_side_difference,
+                         cv::Mat* binary) {
+  CV_Assert(binary->type() == CV_8U && image.type() == CV_32F &&
+            image.size() == binary->size());
+  int dropped = 0;
+  for (int y = 0; y < binary->rows; ++y) {
+    uint8_t* row = binary->ptr<uint8_t>(y);
+    const float* gray = image.ptr<float>(y);
+    int x = 0;
+    while (x < binary->cols) {
+      if (row[x] == 0) {
+        ++x;
+        continue;
+      }
+      const int begin = x;
+      float peak = gray[x];
+      while (x < binary->cols && row[x] != 0) peak = std::max(peak, gray[x++]);
+      // The ground two and three pixels outside the run, each side.
+      auto side = [&](int a, int b) {
+        a = std::clamp(a, 0, binary->cols - 1);
+        b = std::clamp(b, 0, binary->cols - 1);
+        return 0.5 * (gray[a] + gray[b]);
+      };
+      const double left = side(begin - 3, begin - 2);
+      const double right = side(x + 1, x + 2);
+      const double contrast = peak - std::min(left, right);
+      if (std::abs(left - right) > max_side_difference * contrast) {
+        std::fill(row + begin, row + x, 0);
+        ++dropped;
+      }
+    }
+  }
+  return dropped;
+}
+
+cv::Mat ThinLines(const cv::Mat& binary) {
+  cv::Mat skeleton = cv::Mat::zeros(binary.size(), CV_8U);
+  // Thinning costs per pixel of the image: only the part with lines.
+  const cv::Rect box = cv::boundingRect(binary);
+  if (box.area() == 0) return skeleton;
+  const cv::Rect padded = (box + cv::Size(2, 2) - cv::Point(1, 1)) &
+                          cv::Rect(0, 0, binary.cols, binary.rows);
+  cv::Mat thin;
+  cv::ximgproc::thinning(binary(padded), thin,
+                         cv::ximgproc::THINNING_ZHANGSUEN);
+  thin.copyTo(skeleton(padded));
+  return skeleton;
+}
+
+std::vector<std::vector<cv::Point>> FollowChains(const cv::Mat& skeleton,
+                                                 int min_length_px) {
+  CV_Assert(skeleton.type() == CV_8U);
+  cv::Mat work = skeleton.clone();
+  // 4-neighbours first: along a staircase the chain takes the corner pixel
+  // rather than cutting it off as a one-pixel spur.
+  static const int kDx[8] = {1, 0, -1, 0, 1, -1, -1, 1};
+  static const int kDy[8] = {0, 1, 0, -1, 1, 1, -1, -1};
+  auto neighbours = [&](int x, int y) {
+    int n = 0;
+    for (int k = 0; k < 8; ++k) n += IsSet(work, x + kDx[k], y + kDy[k]);
+    return n;
+  };
+  std::vector<std::vector<cv::Point>> chains;
+  auto follow = [&](int x, int y) {
+    std::vector<cv::Point> chain;
+    for (;;) {
+      chain.emplace_back(x, y);
+      work.at<uint8_t>(y, x) = 0;
+      int k = 0;
+      while (k < 8 && !IsSet(work, x + kDx[k], y + kDy[k])) ++k;
+      if (k == 8) break;
+      x += kDx[k];
+      y += kDy[k];
+    }
+    if (static_cast<int>(chain.size()) >= min_length_px) {
+      chains.push_back(std::move(chain));
+    }
+  };
+  // Open chains from their ends, then what is left (closed loops).
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int y = 0; y < work.rows; ++y) {
+      for (int x = 0; x < work.cols; ++x) {
+        if (work.at<uint8_t>(y, x) != 0 &&
+            (pass == 1 || neighbours(x, y) <= 1)) {
+          follow(x, y);
+        }
+      }
+    }
+  }
+  return chains;
+}
+
+std::vector<int> DropCollinearPoints(const std::vector<cv::Point>& chain,
+                                     double tolerance_px, int max_spacing_px) {
+  std::vector<int> kept;
+  if (chain.empty()) return kept;
+  std::vector<cv::Point> approx;
+  cv::approxPolyDP(chain, approx, tolerance_px, false);
+  // approxPolyDP returns points, in chain order: back to indices (a chain
+  // visits each pixel once).
+  std::vector<int> corners;
+  size_t j = 0;
+  for (const cv::Point& p : approx) {
+    while (j < chain.size() && chain[j] != p) ++j;
+    if (j == chain.size()) break;
+    corners.push_back(static_cast<int>(j));
+  }
+  if (corners.empty() || corners.front() != 0)
+    corners.insert(corners.begin(), 0);
+  const int last = static_cast<int>(chain.size()) - 1;
+  if (corners.back() != last) corners.push_back(last);
+  max_spacing_px = std::max(1, max_spacing_px);
+  for (size_t c = 0; c + 1 < corners.size(); ++c) {
+    const int a = corners[c], b = corners[c + 1];
+    const int pieces = (b - a + max_spacing_px - 1) / max_spacing_px;
+    for (int s = 0; s < pieces; ++s) kept.push_back(a + (b - a) * s / pieces);
+  }
+  kept.push_back(last);
+  return kept;
+}
+
+bool RunCentre(const cv::Mat& image, const cv::Mat& binary, int y, int x,
+               double* centre) {
+  if (y < 0 || y >= binary.rows) return false;
+  const uint8_t* b = binary.ptr<uint8_t>(y);
+  if (x < 0 || x >= binary.cols || b[x] == 0) {
+    if (x + 1 >= 0 && x + 1 < binary.cols && b[x + 1] != 0) {
+      ++x;
+    } else if (x - 1 >= 0 && x - 1 < binary.cols && b[x - 1] != 0) {
+      --x;
+    } else {
+      return false;
+    }
+  }
+  int begin = x, end = x + 1;
+  while (begin > 0 && b[begin - 1] != 0) --begin;
+  while (end < binary.cols && b[end] != 0) ++end;
+  // Background: the darker side two pixels outside the run (the median
+  // decision makes the run about a pixel narrower than the paint's blur).
+  const float* row = image.ptr<float>(y);
+  const int lo = std::max(0, begin - 2),
+            hi = std::min(binary.cols - 1, end + 1);
+  const double background = std::min(row[lo], row[hi]);
+  double weight = 0.0, moment = 0.0;
+  for (int i = std::max(0, begin - 1); i <= std::min(binary.cols - 1, end);
+       ++i) {
+    const double w = std::max(0.0, row[i] - background);
+    weight += w;
+    moment += w * i;
+  }
+  if (!(weight > 0.0)) return false;
+  *centre = moment / weight;
+  return true;
+}
+
+const char* RoadLineTypeName(RoadLineType type) {
+  switch (type) {
+    case RoadLineType::kLaneSolid:
+      return "lane_solid";
+    case RoadLineType::kLaneDashed:
+      return "lane_dashed";
+    case RoadLineType::kStopLine:
+      return "stop_line";
+  }
+  return "lane_solid";
+}
+
+StereoLineExtractor::StereoLineExtractor(const RigCamera& left,
+                                         const RigCamera& right,
+                                         const RoadPlane& road,
+                                         const RoadLineOptions& options)
+    : cameras_{left, right}, road_(road), options_(options) {
+  error_ = options.Check();
+  if (!error_.empty()) return;
+  RectificationOptions rectification;
+  rectification.ground_pixel_m = options.ground_pixel_m;
+  rectification.max_range_m = options.max_range_m;
+  rectification.max_lateral_m = options.max_lateral_m;
+  rectification_.Build(left, right, road, rectification, &error_);
+}
+
+PairLines StereoLineExtractor::Extract(const cv::Mat& left_image,
+                                       const cv::Mat& right_image) const {
+  const double start = ThreadCpuSeconds();
+  PairLines out;
+  cv::Mat left, right;
+  rectification_.Rectify(left_image, right_image, &left, &right);
+  LaneLines(left, right, &out);
+  StopLines(left, &out);
+  out.seconds = ThreadCpuSeconds() - start;
+  return out;
+}
+
+void StereoLineExtractor::LaneLines(const cv::Mat& left, const cv::Mat& right,
+                                    PairLines* out) const {
+  const RoadRectification& rect = rectification_;
+  const cv::Mat& valid = rect.valid_mask();
+  const double gsd = rect.ground_pixel_m();
+  const int min_px = std::max(
+      1, static_cast<int>(std::floor(options_.min_line_width_m / gsd)));
+  const int max_px =
+      static_cast<int>(std::ceil(options_.max_line_width_m / gsd));
+  cv::Mat bright[2];
+  const cv::Mat* images[2] = {&left, &right};
+  for (int side = 0; side < 2; ++side) {
+    bright[side] =
+        BrightLinePixels(*images[side], valid, options_.median_window_px,
+                         options_.threshold_sigmas, options_.plain_statistics);
+    const int wide = KeepRunsByWidth(valid, min_px, max_px, &bright[side]);
+    KeepRunsOnEvenGround(*images[side], options_.max_side_difference,
+                         &bright[side]);
+    if (side == 0) out->wide_runs = wide;
+  }
+  const std::vector<std::vector<cv::Point>> chains =
+      FollowChains(ThinLines(bright[0]), options_.min_chain_px);
+  out->chains += static_cast<int>(chains.size());
+  const double sigma2 = options_.centre_sigma_px * options_.centre_sigma_px;
+  const Eigen::Vector3d pixel_variance(sigma2, sigma2, sigma2);
+  const int spacing_px = static_cast<int>(options_.max_vertex_spacing_m / gsd);
+  const double h = options_.max_height_off_road_m;
+  for (const std::vector<cv::Point>& chain : chains) {
+    if (!RunsAcrossRows(chain)) continue;
+    std::vector<ChainPoint> points;
+    for (int i = 0; i < static_cast<int>(chain.size()); ++i) {
+      const int y = chain[i].y;
+      double x_left = 0.0;
+      if (!RunCentre(left, bright[0], y, chain[i].x, &x_left)) continue;
+      // The search volume: the residual disparities of the slab.
+      Eigen::Vector3d on_road;
+      if (!road_.IntersectRay(rect.left_centre_body(),
+                              rect.RayBody(0, Eigen::Vector2d(x_left, y)),
+                              &on_road)) {
+        continue;
+      }
+      const double d1 = rect.DisparityOf(on_road - h * road_.normal_body);
+      const double d2 = rect.DisparityOf(on_road + h * road_.normal_body);
+      if (!std::isfinite(d1) || !std::isfinite(d2)) continue;
+      const double lo = x_left - std::max(d1, d2);
+      const double hi = x_left - std::min(d1, d2);
+      // The one right run whose centre is in [lo, hi].
+      const uint8_t* b = bright[1].ptr<uint8_t>(y);
+      int found = 0;
+      double x_right = 0.0;
+      const int from = std::max(0, static_cast<int>(std::floor(lo)) - max_px);
+      const int to =
+          std::min(right.cols - 1, static_cast<int>(std::ceil(hi)) + max_px);
+      for (int x = from; x <= to; ++x) {
+        if (b[x] == 0 || (x > from && b[x - 1] != 0)) continue;
+        double centre = 0.0;
+        if (RunCentre(right, bright[1], y, x, &centre) && centre >= lo &&
+            centre <= hi) {
+          ++found;
+          x_right = centre;
+        }
+      }
+      if (found != 1) continue;
+      ChainPoint point;
+      point.index = i;
+      if (!rect.Triangulate(x_left, x_right, y, &point.p)) continue;
+      const Eigen::Matrix3d J = rect.TriangulationJacobian(x_left, x_right, y);
+      point.covariance = J * pixel_variance.asDiagonal() * J.transpose();
+      points.push_back(point);
+    }
+    out->matched_pixels += static_cast<int>(points.size());
+    RoadLine3d line;
+    AverageVertices(
+        points,
+        DropCollinearPoints(chain, options_.collinear_tolerance_px, spacing_px),
+        options_, &line);
+    if (line.points_body.size() < 2) continue;
+    const int margin = options_.median_window_px;
+    const bool ends_seen = InsideValid(valid, chain.front(), margin) &&
+                           InsideValid(valid, chain.back(), margin);
+    line.type = ends_seen && PolylineLength(line.points_body) <=
+                                 options_.max_dash_length_m
+                    ? RoadLineType::kLaneDashed
+                    : RoadLineType::kLaneSolid;
+    if (Finish(&line)) out->lines.push_back(std::move(line));
+  }
+}
+
+void StereoLineExtractor::StopLines(const cv::Mat& left, PairLines* out) const {
+  const RoadRectification& rect = rectification_;
+  const double gsd = rect.ground_pixel_m();
+  // Stop lines run along the rows: the scan lines are the columns.
+  cv::Mat image, valid;
+  cv::transpose(left, image);
+  cv::transpose(rect.valid_mask(), valid);
+  cv::Mat bright =
+      BrightLinePixels(image, valid, options_.median_window_px,
+                       options_.threshold_sigmas, options_.plain_statistics);
+  KeepRunsByWidth(
+      valid,
+      std::max(1, static_cast<int>(
+                      std::floor(options_.min_stop_line_width_m / gsd))),
+      static_cast<int>(std::ceil(options_.max_stop_line_width_m / gsd)),
+      &bright);
+  KeepRunsOnEvenGround(image, options_.max_side_difference, &bright);
+  const int min_length_px =
+      std::max(options_.min_chain_px,
+               static_cast<int>(options_.min_stop_line_length_m / gsd));
+  const std::vector<std::vector<cv::Point>> chains =
+      FollowChains(ThinLines(bright), min_length_px);
+  out->chains += static_cast<int>(chains.size());
+  // On the road plane one rectified pixel is gsd metres; across the line
+  // (rectified y) the centre's error, along the normal the plane's.
+  const Eigen::Vector3d across = rect.R_body_virt().col(1);
+  const Eigen::Vector3d along = rect.R_body_virt().col(0);
+  const double s = gsd * options_.centre_sigma_px;
+  const Eigen::Matrix3d image_covariance =
+      s * s * (across * across.transpose() + along * along.transpose());
+  const double sh = options_.stop_line_height_sigma_m;
+  const Eigen::Matrix3d height_covariance =
+      sh * sh * road_.normal_body * road_.normal_body.transpose();
+  const int spacing_px = static_cast<int>(options_.max_vertex_spacing_m / gsd);
+  for (const std::vector<cv::Point>& chain : chains) {
+    if (!RunsAcrossRows(chain)) continue;
+    std::vector<ChainPoint> points;
+    for (int i = 0; i < static_cast<int>(chain.size()); ++i) {
+      // Transposed: the chain's row is the rectified column.
+      double y = 0.0;
+      if (!RunCentre(image, bright, chain[i].y, chain[i].x, &y)) continue;
+      ChainPoint point;
+      point.index = i;
+      if (!road_.IntersectRay(rect.left_centre_body(),
+                              rect.RayBody(0, Eigen::Vector2d(chain[i].y, y)),
+                              &point.p)) {
+        continue;
+      }
+      point.covariance = image_covariance;
+      points.push_back(point);
+    }
+    RoadLine3d line;
+    line.type = RoadLineType::kStopLine;
+    AverageVertices(
+        points,
+        DropCollinearPoints(chain, options_.collinear_tolerance_px, spacing_px),
+        options_, &line);
+    if (line.points_body.size() < 2 ||
+        PolylineLength(line.points_body) < options_.min_stop_line_length_m) {
+      continue;
+    }
+    // The plane's height error is common to all points: not averaged.
+    for (Eigen::Matrix3d& c : line.covariances_body) c += height_covariance;
+    if (Finish(&line)) out->lines.push_back(std::move(line));
+  }
+}
+
+bool StereoLineExtractor::Finish(RoadLine3d* line) const {
+  for (const Eigen::Vector3d& p : line->points_body) {
+    Eigen::Vector2d uv[2];
+    for (int side = 0; side < 2; ++side) {
+      if (!cameras_[side].camera.Project(
+              cameras_[side].T_body_cam.inverse() * p, &uv[side])) {
+        return false;
+      }
+    }
+    line->uv_left.push_back(uv[0]);
+    line->uv_right.push_back(uv[1]);
+  }
+  return true;
+}
+
+void WriteReconstructedLines(const std::vector<ReconstructedLinePoint>& points,
+                             const std::vector<std::string>& comments,
+                             const std::string& path) {
+  AtomicFile file(path);
+  CsvWriter csv(&file.stream());
+  for (const std::string& comment : comments) csv.Comment(comment);
+  csv.Header({"exposure_id", "pair", "line_id", "type", "point", "x", "y", "z",
+              "cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz",
+              "u_left", "v_left", "u_right", "v_right"});
+  for (const ReconstructedLinePoint& p : points) {
+    const Eigen::Matrix3d& c = p.covariance_body;
+    csv.Add(p.exposure_id)
+        .Add(p.pair)
+        .Add(p.line_id)
+        .Add(RoadLineTypeName(p.type))
+        .Add(p.point)
+        .Add(p.p_body.x())
+        .Add(p.p_body.y())
+        .Add(p.p_body.z())
+        .Add(c(0, 0))
+        .Add(c(0, 1))
+        .Add(c(0, 2))
+        .Add(c(1, 1))
+        .Add(c(1, 2))
+        .Add(c(2, 2))
+        .Add(p.uv_left.x())
+        .Add(p.uv_left.y())
+        .Add(p.uv_right.x())
+        .Add(p.uv_right.y());
+    csv.EndRow();
+  }
+  file.Commit();
+}
+
+std::string RoadLineSummary::BriefReport() const {
+  std::ostringstream out;
+  out << lines << " road lines (" << lines_of_type[0] << " solid, "
+      << lines_of_type[1] << " dashed, " << lines_of_type[2] << " stop lines), "
+      << points << " points from " << pairs << " stereo pairs, "
+      << 1e3 * seconds_per_pair << " ms CPU per pair";
+  return out.str();
+}
+
+RoadLineSummary ExtractSurveyLines(
+    const Survey& survey, const RoadPlane& road, const RoadLineOptions& options,
+    int threads, std::vector<ReconstructedLinePoint>* points,
+    const std::function<void(int, int)>& progress) {
+  RoadLineSummary summary;
+  const Rig& rig = survey.rig;
+  std::vector<std::unique_ptr<StereoLineExtractor>> extractors;
+  for (const auto& pair : rig.stereo_pairs) {
+    auto extractor = std::make_unique<StereoLineExtractor>(
+        rig.cameras[pair[0]], rig.cameras[pair[1]], road, options);
+    if (!extractor->ok()) {
+      LOG(WARNING) << "road lines: a stereo pair cannot be rectified: "
+                   << extractor->error();
+      extractor.reset();
+    }
+    extractors.push_back(std::move(extractor));
+  }
+  const std::vector<Exposure>& exposures = survey.exposures.exposures;
+  const int total = static_cast<int>(exposures.size());
+  // results[e][p]: the lines of pair p of exposure e (empty when the
+  // images are missing: the zebra stage already warned).
+  std::vector<std::vector<PairLines>> results(total);
+  std::vector<std::vector<bool>> ran(total);
+  std::mutex progress_mutex;
+  int done = 0;
+  if (threads <= 0) {
+    threads =
+        std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  }
+  ParallelFor(total, threads, [&](int e) {
+    const Exposure& exposure = exposures[e];
+    results[e].resize(extractors.size());
+    ran[e].assign(extractors.size(), false);
+    for (size_t p = 0; p < extractors.size(); ++p) {
+      if (!extractors[p]) continue;
+      cv::Mat images[2];
+      bool read = true;
+      for (int side = 0; side < 2 && read; ++side) {
+        const int camera = rig.stereo_pairs[p][side];
+        const int index = exposure.image_of_camera[camera];
+        if (index < 0) {
+          read = false;
+          break;
+        }
+        const ExposureImage& image = survey.exposures.images[index];
+        try {
+          images[side] = ReadGrayImage(survey.PathOf(image.image), image.image,
+                                       rig.cameras[camera].camera.width(),
+                                       rig.cameras[camera].camera.height());
+        } catch (const std::exception&) {
+          read = false;
+        }
+      }
+      if (!read) continue;
+      results[e][p] = extractors[p]->Extract(images[0], images[1]);
+      ran[e][p] = true;
+    }
+    if (progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      progress(++done, total);
+    }
+  });
+  double seconds = 0.0;
+  int64_t line_id = 0;
+  for (int e = 0; e < total; ++e) {
+    for (size_t p = 0; p < results[e].size(); ++p) {
+      if (!ran[e][p]) continue;
+      ++summary.pairs;
+      seconds += results[e][p].seconds;
+      for (const RoadLine3d& line : results[e][p].lines) {
+        ++line_id;
+        ++summary.lines;
+        ++summary.lines_of_type[static_cast<int>(line.type)];
+        for (size_t k = 0; k < line.points_body.size(); ++k) {
+          ReconstructedLinePoint point;
+          point.exposure_id = exposures[e].exposure_id;
+          point.pair = static_cast<int>(p);
+          point.line_id = line_id;
+          point.type = line.type;
+          point.point = static_cast<int>(k);
+          point.p_body = line.points_body[k];
+          point.covariance_body = line.covariances_body[k];
+          point.uv_left = line.uv_left[k];
+          point.uv_right = line.uv_right[k];
+          points->push_back(point);
+          ++summary.points;
+        }
+      }
+    }
+  }
+  summary.seconds_per_pair = seconds / std::max(1, summary.pairs);
+  return summary;
+}
+
+}  // namespace zebrageo

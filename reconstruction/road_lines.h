@@ -1,0 +1,246 @@
+// Road lines (lane lines and stop lines) from the stereo pairs of a survey:
+// the bright-line extractor of the Ohio State GPS-Van (XVIIth ISPRS
+// Congress 1992, part B3, "Extraction of road edges and center-lines",
+// sections 3.1 to 3.3; ../shared/seeds/001_*.txt), GitHub issue 9.
+//
+// It runs on the road-plane rectified pair of reconstruction/ (see
+// road_rectification.h): there the images are orthoimages of the road,
+// lane lines run along the columns (the seed's "bright linear features
+// which run from top to bottom"), stop lines along the rows, and a road
+// point has the same pixel in both images. Per stereo pair:
+//   1. per scan line, the mean and standard deviation of the gray values
+//      (valid pixels only); a pixel is bright when the 5-pixel median around
+//      it exceeds the mean by more than 1.5 standard deviations (binary
+//      image); runs of bright pixels wider or narrower than a painted line
+//      are cleared: zebra bands (0.5 m wide) are recognised here and left
+//      to the zebra front-end;
+//   2. thinning to one pixel (Zhang-Suen, OpenCV ximgproc);
+//   3. line following by chain coding; chains under 10 pixels dropped;
+//   4. interior points collinear with their neighbours dropped (the
+//      polyline keeps a vertex at least every max_vertex_spacing_m, so the
+//      3D line keeps its height profile);
+//   5. stereo: each chain pixel's sub-pixel run centre on the left row is
+//      matched with the one bright run of the same right row inside the
+//      search volume (a slab around the road plane); triangulated to the
+//      body frame with the covariance of the centres;
+//   6. 3D vertices: the triangulated points around each polyline vertex,
+//      averaged, with their covariance.
+// The scan lines of step 1 are image rows for lane lines; the same steps on
+// the columns (the transposed image) give stop lines, which lie along the
+// epipolar lines and so cannot be matched in stereo: their points are the
+// left rays intersected with the road plane, the covariance carrying the
+// plane's height uncertainty.
+//
+// Frames: body (FRD) metres for every 3D output; image coordinates of the
+// outputs are pixels of the ORIGINAL (distorted) images, (0, 0) the centre
+// of the top-left pixel.
+#ifndef ZEBRAGEO_RECONSTRUCTION_ROAD_LINES_H_
+#define ZEBRAGEO_RECONSTRUCTION_ROAD_LINES_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "reconstruction/road_rectification.h"
+#include "survey/rig.h"
+#include "survey/survey.h"
+
+namespace zebrageo {
+
+struct RoadLineOptions {
+  // Rectified road images for lines: coarser than for zebra vertices (a
+  // 15 cm lane line is still 5 pixels wide) and shorter (heights from
+  // stereo degrade with the square of the range).
+  double ground_pixel_m = 0.03;
+  double max_range_m = 16.0;
+  double max_lateral_m = 8.0;
+  // Step 1, the seed's values: median window (odd) and threshold.
+  int median_window_px = 5;
+  double threshold_sigmas = 1.5;
+  // Robustness: the scan line's "mean and standard deviation" are its
+  // median and 1.4826 x median absolute deviation; true: the seed's plain
+  // mean and deviation, which the paint of zebra bands crossing the scan
+  // line raises over a stop line's contrast.
+  bool plain_statistics = false;
+  // Widths of the bright runs kept across a lane line (along a row) and
+  // across a stop line (along a column), metres on the road. Wider runs are
+  // zebra bands or marks across the scan line; narrower ones noise.
+  double min_line_width_m = 0.06;
+  double max_line_width_m = 0.3;
+  double min_stop_line_width_m = 0.18;
+  // (A 0.3 m stop line 10 m ahead spans a few original pixels along the
+  // road: blurred, its run is 0.5 m wide and more.)
+  double max_stop_line_width_m = 0.9;
+  // Paint lies on even ground: a run whose two sides differ by more than
+  // this share of its contrast is the edge of something else (a kerb
+  // between gutter and sidewalk, a sidewalk's tiles).
+  double max_side_difference = 0.5;
+  // Step 3: shorter chains are dropped (the seed's 10 pixels).
+  int min_chain_px = 10;
+  // Stop lines shorter than this across the road are dropped (the ends of
+  // dashes and band sides cut by the image border look like short stop
+  // lines).
+  double min_stop_line_length_m = 0.8;
+  // Step 4: a point closer than this to the chord of its neighbours is
+  // collinear (Douglas-Peucker tolerance).
+  double collinear_tolerance_px = 0.7;
+  double max_vertex_spacing_m = 2.0;
+  // Step 5: the search volume, a slab of this half-thickness around the
+  // road plane.
+  double max_height_off_road_m = 0.25;
+  // Standard deviation of a run centre across the line, pixels; centres of
+  // neighbouring rows are correlated over about `correlation_px` rows, which
+  // bounds what averaging gains.
+  double centre_sigma_px = 0.3;
+  double correlation_px = 3.0;
+  // Step 6: triangulated points within this many chain pixels of a vertex
+  // are averaged into it; fewer than min_vertex_points: no vertex.
+  int vertex_half_window_px = 8;
+  int min_vertex_points = 4;
+  // A lane chain whose both ends are inside the images and which is at
+  // most this long is a dash; otherwise a solid line (or a dash seen in
+  // part: the database tells them apart).
+  double max_dash_length_m = 5.0;
+  // Stop lines: height uncertainty of the road plane they are put on.
+  double stop_line_height_sigma_m = 0.03;
+
+  std::string Check() const;
+};
+
+// --- The steps, exposed for tests ------------------------------------------
+
+// Step 1 on the rows of a CV_32F image: CV_8U, 255 where the median of the
+// `median_window_px` valid pixels around a pixel (on its row) exceeds the
+// row's mean by more than threshold_sigmas standard deviations (robust
+// ones unless plain_statistics, see RoadLineOptions). `valid` (CV_8U, or
+// empty for all valid) limits the statistics and the result.
+cv::Mat BrightLinePixels(const cv::Mat& image, const cv::Mat& valid,
+                         int median_window_px, double threshold_sigmas,
+                         bool plain_statistics = false);
+
+// Step 1, end: clears the runs of a row that are narrower than min_px or
+// wider than max_px, and those touching an invalid pixel or the image side
+// (their width is unknown). Returns how many runs were wider than max_px.
+int KeepRunsByWidth(const cv::Mat& valid, int min_px, int max_px,
+                    cv::Mat* binary);
+
+// Step 1, end: clears the runs of a row whose ground two and three pixels
+// outside differ, left to right, by more than max_side_difference times the
+// run's contrast (peak over the darker side). Returns how many were cleared.
+int KeepRunsOnEvenGround(const cv::Mat& image, double max_side_difference,
+                         cv::Mat* binary);
+
+// Step 2: one-pixel-wide skeleton of a CV_8U 0/255 image.
+cv::Mat ThinLines(const cv::Mat& binary);
+
+// Step 3: chains of 8-connected skeleton pixels, from an end to the other
+// (closed loops from any pixel), each pixel in exactly one chain; chains
+// with fewer than min_length_px pixels are dropped. Deterministic (raster
+// order).
+std::vector<std::vector<cv::Point>> FollowChains(const cv::Mat& skeleton,
+                                                 int min_length_px);
+
+// Step 4: indices into `chain` of the points kept: both ends, the points
+// farther than tolerance_px from the chord of their neighbours (Douglas-
+// Peucker), and enough in between that consecutive kept points are at most
+// max_spacing_px apart along the chain.
+std::vector<int> DropCollinearPoints(const std::vector<cv::Point>& chain,
+                                     double tolerance_px, int max_spacing_px);
+
+// Step 5: sub-pixel centre of the bright run of row `y` containing x (or
+// starting within one pixel of it): the centroid of gray value above the
+// row's background. False when no run is there.
+bool RunCentre(const cv::Mat& image, const cv::Mat& binary, int y, int x,
+               double* centre);
+
+// --- A stereo pair -----------------------------------------------------------
+
+enum class RoadLineType { kLaneSolid, kLaneDashed, kStopLine };
+const char* RoadLineTypeName(RoadLineType type);  // lane_solid, ...
+
+struct RoadLine3d {
+  RoadLineType type = RoadLineType::kLaneSolid;
+  std::vector<Eigen::Vector3d> points_body;
+  std::vector<Eigen::Matrix3d> covariances_body;
+  std::vector<Eigen::Vector2d> uv_left;   // original image pixels
+  std::vector<Eigen::Vector2d> uv_right;  // (NaN-free: projected)
+};
+
+struct PairLines {
+  std::vector<RoadLine3d> lines;
+  int chains = 0;          // after step 3 (lanes and stop lines)
+  int wide_runs = 0;       // row runs too wide for a lane line (bands...)
+  int matched_pixels = 0;  // lane chain pixels matched in stereo
+  double seconds = 0.0;    // CPU time of the calling thread
+};
+
+class StereoLineExtractor {
+ public:
+  // `road`: the road plane in the body frame (the zebra front-end's
+  // estimate). Check ok() before use.
+  StereoLineExtractor(const RigCamera& left, const RigCamera& right,
+                      const RoadPlane& road, const RoadLineOptions& options);
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  const RoadRectification& rectification() const { return rectification_; }
+
+  // Runs steps 1 to 6 on two original CV_32F images.
+  PairLines Extract(const cv::Mat& left_image,
+                    const cv::Mat& right_image) const;
+
+ private:
+  void LaneLines(const cv::Mat& left, const cv::Mat& right,
+                 PairLines* out) const;
+  void StopLines(const cv::Mat& left, PairLines* out) const;
+  bool Finish(RoadLine3d* line) const;  // uv, false if not projectable
+
+  RigCamera cameras_[2];
+  RoadPlane road_;
+  RoadLineOptions options_;
+  RoadRectification rectification_;
+  std::string error_;
+};
+
+// --- A survey ----------------------------------------------------------------
+
+// reconstructed_lines.csv: one row per vertex of a line seen in one pair.
+struct ReconstructedLinePoint {
+  int64_t exposure_id = 0;
+  int pair = 0;
+  int64_t line_id = 0;  // unique within the file
+  RoadLineType type = RoadLineType::kLaneSolid;
+  int point = 0;  // 0.. along the line
+  Eigen::Vector3d p_body = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance_body = Eigen::Matrix3d::Zero();
+  Eigen::Vector2d uv_left = Eigen::Vector2d::Zero();
+  Eigen::Vector2d uv_right = Eigen::Vector2d::Zero();
+};
+
+inline constexpr char kReconstructedLinesFile[] = "reconstructed_lines.csv";
+
+void WriteReconstructedLines(const std::vector<ReconstructedLinePoint>& points,
+                             const std::vector<std::string>& comments,
+                             const std::string& path);
+
+struct RoadLineSummary {
+  int pairs = 0;
+  int lines = 0;
+  int lines_of_type[3] = {0, 0, 0};
+  int points = 0;
+  double seconds_per_pair = 0.0;  // CPU
+  std::string BriefReport() const;
+};
+
+// Extracts the lines of every stereo pair of every exposure (threads: 0 =
+// one per hardware thread), in a deterministic order.
+RoadLineSummary ExtractSurveyLines(
+    const Survey& survey, const RoadPlane& road, const RoadLineOptions& options,
+    int threads, std::vector<ReconstructedLinePoint>* points,
+    const std::function<void(int, int)>& progress = nullptr);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_RECONSTRUCTION_ROAD_LINES_H_

@@ -1,0 +1,286 @@
+#include "reconstruction/road_lines.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+namespace zebrageo {
+namespace {
+
+// A CV_32F image of `rows` x `cols` gray 100 with Gaussian noise.
+cv::Mat NoisyBackground(int rows, int cols, double sigma, unsigned seed) {
+  cv::Mat image(rows, cols, CV_32F);
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, static_cast<float>(sigma));
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) image.at<float>(y, x) = 100.0f + noise(rng);
+  }
+  return image;
+}
+
+int CountSet(const cv::Mat& binary, int y, int x0, int x1) {
+  int n = 0;
+  for (int x = x0; x < x1; ++x) n += binary.at<uint8_t>(y, x) != 0;
+  return n;
+}
+
+TEST(BrightLinePixels, FindsAPaintedLineAndIgnoresASpike) {
+  cv::Mat image = NoisyBackground(20, 120, 3.0, 1);
+  image(cv::Rect(40, 0, 5, 20)).setTo(200.0f);  // a 5-pixel line
+  image.at<float>(10, 90) = 255.0f;             // one hot pixel
+  // The seed's plain mean and deviation of the scan line.
+  const cv::Mat bright = BrightLinePixels(image, cv::Mat(), 5, 1.5, true);
+  for (int y = 0; y < image.rows; ++y) {
+    // The median keeps the line's edges: exactly its 5 pixels.
+    EXPECT_EQ(CountSet(bright, y, 40, 45), 5) << "row " << y;
+    EXPECT_EQ(CountSet(bright, y, 38, 40) + CountSet(bright, y, 45, 47), 0);
+    EXPECT_EQ(CountSet(bright, y, 0, 38) + CountSet(bright, y, 47, 120), 0)
+        << "row " << y;
+  }
+}
+
+TEST(BrightLinePixels, UsesOnlyValidPixelsForTheStatistics) {
+  cv::Mat image = NoisyBackground(4, 100, 2.0, 2);
+  image(cv::Rect(0, 0, 50, 4)).setTo(1000.0f);  // invalid, very bright
+  image(cv::Rect(70, 0, 6, 4)).setTo(160.0f);   // the line
+  cv::Mat valid = cv::Mat::zeros(image.size(), CV_8U);
+  valid(cv::Rect(50, 0, 50, 4)).setTo(255);
+  const cv::Mat with_mask = BrightLinePixels(image, valid, 5, 1.5);
+  const cv::Mat without = BrightLinePixels(image, cv::Mat(), 5, 1.5);
+  for (int y = 0; y < 4; ++y) {
+    EXPECT_GE(CountSet(with_mask, y, 70, 76), 4);
+    EXPECT_EQ(CountSet(with_mask, y, 0, 52), 0);
+    // Without the mask the bright invalid half sets the threshold: the
+    // line is lost.
+    EXPECT_EQ(CountSet(without, y, 70, 76), 0);
+  }
+}
+
+TEST(BrightLinePixels, RobustStatisticsKeepALineBesideZebraBands) {
+  cv::Mat image = NoisyBackground(4, 200, 2.0, 3);
+  for (int x = 10; x < 130; x += 34) {
+    image(cv::Rect(x, 0, 17, 4)).setTo(210.0f);  // bands: 35 % of the row
+  }
+  image(cv::Rect(160, 0, 8, 4)).setTo(185.0f);  // a line, a bit darker
+  const cv::Mat plain = BrightLinePixels(image, cv::Mat(), 5, 1.5, true);
+  const cv::Mat robust = BrightLinePixels(image, cv::Mat(), 5, 1.5, false);
+  for (int y = 0; y < 4; ++y) {
+    EXPECT_EQ(CountSet(plain, y, 155, 175), 0);  // the seed loses it
+    EXPECT_EQ(CountSet(robust, y, 160, 168), 8);
+  }
+}
+
+TEST(KeepRunsByWidth, KeepsLineWidthsAndCountsBands) {
+  cv::Mat binary = cv::Mat::zeros(3, 100, CV_8U);
+  binary(cv::Rect(10, 0, 2, 3)).setTo(255);   // noise
+  binary(cv::Rect(30, 0, 5, 3)).setTo(255);   // a lane line
+  binary(cv::Rect(50, 0, 17, 3)).setTo(255);  // a zebra band
+  binary(cv::Rect(95, 0, 5, 3)).setTo(255);   // cut by the image side
+  EXPECT_EQ(KeepRunsByWidth(cv::Mat(), 3, 10, &binary), 3);
+  for (int y = 0; y < 3; ++y) {
+    EXPECT_EQ(CountSet(binary, y, 0, 100), 5);
+    EXPECT_EQ(CountSet(binary, y, 30, 35), 5);
+  }
+}
+
+TEST(KeepRunsOnEvenGround, DropsAKerbBetweenGutterAndSidewalk) {
+  cv::Mat image(2, 60, CV_32F, cv::Scalar(70.0f));
+  image(cv::Rect(10, 0, 5, 2)).setTo(200.0f);   // paint on asphalt
+  image(cv::Rect(40, 0, 5, 2)).setTo(150.0f);   // kerb ...
+  image(cv::Rect(45, 0, 15, 2)).setTo(130.0f);  // ... then the sidewalk
+  cv::Mat binary = cv::Mat::zeros(image.size(), CV_8U);
+  binary(cv::Rect(10, 0, 5, 2)).setTo(255);
+  binary(cv::Rect(40, 0, 5, 2)).setTo(255);
+  EXPECT_EQ(KeepRunsOnEvenGround(image, 0.5, &binary), 2);
+  for (int y = 0; y < 2; ++y) {
+    EXPECT_EQ(CountSet(binary, y, 10, 15), 5);
+    EXPECT_EQ(CountSet(binary, y, 30, 60), 0);
+  }
+}
+
+TEST(ThinLines, LeavesOnePixelPerRowNearTheMiddle) {
+  cv::Mat binary = cv::Mat::zeros(60, 40, CV_8U);
+  binary(cv::Rect(15, 5, 5, 50)).setTo(255);  // columns 15..19, middle 17
+  const cv::Mat skeleton = ThinLines(binary);
+  for (int y = 10; y < 50; ++y) {
+    ASSERT_EQ(CountSet(skeleton, y, 0, 40), 1) << "row " << y;
+    int x = 0;
+    while (skeleton.at<uint8_t>(y, x) == 0) ++x;
+    EXPECT_LE(std::abs(x - 17), 1) << "row " << y;
+  }
+}
+
+TEST(FollowChains, EveryPixelOnceShortChainsDropped) {
+  cv::Mat skeleton = cv::Mat::zeros(50, 50, CV_8U);
+  // An L: down column 5 from row 2 to 30, then right along row 30 to 25.
+  for (int y = 2; y <= 30; ++y) skeleton.at<uint8_t>(y, 5) = 255;
+  for (int x = 6; x <= 25; ++x) skeleton.at<uint8_t>(30, x) = 255;
+  // A diagonal of 15 pixels and a 4-pixel stub.
+  for (int k = 0; k < 15; ++k) skeleton.at<uint8_t>(5 + k, 30 + k) = 255;
+  for (int x = 40; x < 44; ++x) skeleton.at<uint8_t>(45, x) = 255;
+  // A closed ring (no end).
+  cv::circle(skeleton, cv::Point(15, 12), 6, 255, 1);
+  const cv::Mat ring = skeleton(cv::Rect(8, 5, 15, 15)).clone();
+  const int ring_pixels = cv::countNonZero(ring);
+  const auto chains = FollowChains(skeleton, 10);
+  ASSERT_EQ(chains.size(), 3u);
+  EXPECT_EQ(chains[0].size(), 29u + 20u);  // the L, from its top end
+  EXPECT_EQ(chains[0].front(), cv::Point(5, 2));
+  EXPECT_EQ(chains[0].back(), cv::Point(25, 30));
+  EXPECT_EQ(chains[1].size(), 15u);
+  EXPECT_EQ(static_cast<int>(chains[2].size()), ring_pixels);
+  for (const auto& chain : chains) {
+    for (size_t i = 1; i < chain.size(); ++i) {
+      EXPECT_LE(std::abs(chain[i].x - chain[i - 1].x), 1);
+      EXPECT_LE(std::abs(chain[i].y - chain[i - 1].y), 1);
+    }
+  }
+}
+
+TEST(DropCollinearPoints, KeepsEndsCornersAndSpacing) {
+  std::vector<cv::Point> chain;
+  for (int y = 0; y <= 100; ++y) chain.emplace_back(10, y);
+  for (int x = 11; x <= 60; ++x) chain.emplace_back(x, 100);
+  const std::vector<int> kept = DropCollinearPoints(chain, 0.7, 1000);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_EQ(kept[0], 0);
+  EXPECT_EQ(chain[kept[1]], cv::Point(10, 100));
+  EXPECT_EQ(kept[2], static_cast<int>(chain.size()) - 1);
+  const std::vector<int> spaced = DropCollinearPoints(chain, 0.7, 30);
+  for (size_t i = 1; i < spaced.size(); ++i) {
+    EXPECT_GT(spaced[i], spaced[i - 1]);
+    EXPECT_LE(spaced[i] - spaced[i - 1], 30);
+  }
+  EXPECT_NE(std::find(spaced.begin(), spaced.end(), kept[1]), spaced.end());
+}
+
+TEST(RunCentre, SubPixelCentreOfABlurredLine) {
+  for (double centre : {20.0, 20.3, 20.5, 20.8}) {
+    cv::Mat image(1, 50, CV_32F);
+    for (int x = 0; x < 50; ++x) {
+      // A 5-pixel box blurred by the optics (Gaussian, sigma 0.8 px).
+      const double a = (x - centre + 2.5) / (0.8 * std::sqrt(2.0));
+      const double b = (x - centre - 2.5) / (0.8 * std::sqrt(2.0));
+      image.at<float>(0, x) =
+          static_cast<float>(90.0 + 60.0 * 0.5 * (std::erf(a) - std::erf(b)));
+    }
+    const cv::Mat bright = BrightLinePixels(image, cv::Mat(), 5, 1.5, true);
+    double found = 0.0;
+    ASSERT_TRUE(RunCentre(image, bright, 0, 20, &found));
+    EXPECT_NEAR(found, centre, 0.1);
+    EXPECT_FALSE(RunCentre(image, bright, 0, 40, &found));
+  }
+}
+
+// Two 640 x 480 cameras 1 m apart, 2.5 m over the road (body z down, the
+// road at z = +1), pitched down by 20 degrees.
+RigCamera MakeCamera(const std::string& name, double y) {
+  RigCamera rig_camera;
+  rig_camera.camera =
+      Camera(name, 640, 480, 550.0, 550.0, 320.0, 240.0, {0, 0, 0, 0, 0});
+  const double pitch = 20.0 * M_PI / 180.0;
+  Eigen::Matrix3d R_body_cam;
+  R_body_cam.col(0) = Eigen::Vector3d(0, 1, 0);
+  R_body_cam.col(2) = Eigen::Vector3d(std::cos(pitch), 0, std::sin(pitch));
+  R_body_cam.col(1) = R_body_cam.col(2).cross(R_body_cam.col(0));
+  rig_camera.T_body_cam.linear() = R_body_cam;
+  rig_camera.T_body_cam.translation() = Eigen::Vector3d(0.8, y, -1.5);
+  return rig_camera;
+}
+
+// The painted road of the stereo test, in the body frame (x forward, y
+// right) on the plane z = 1: a solid line at y = -1.8, dashes at y = 1.6
+// (3 m long, 6 m apart), a stop line across at x = 11 from y = -1.8 to
+// -0.1, and a zebra crossing (0.5 m bands, x from 13 to 16).
+double Paint(double x, double y) {
+  const double w = 0.15;
+  if (std::abs(y + 1.8) < w / 2 && x < 12.5) return 1.0;
+  if (std::abs(y - 1.6) < w / 2 && std::fmod(x + 100.0, 6.0) < 3.0) {
+    return 1.0;
+  }
+  if (std::abs(x - 11.0) < 0.15 && y > -1.8 && y < -0.1) return 1.0;
+  if (x > 13.0 && x < 16.0 && y > -3.0 && y < 3.0 &&
+      std::fmod(y + 100.0, 1.0) < 0.5) {
+    return 1.0;
+  }
+  return 0.0;
+}
+
+cv::Mat Render(const RigCamera& c, unsigned seed) {
+  cv::Mat image(c.camera.height(), c.camera.width(), CV_32F);
+  const Eigen::Matrix3d R = c.T_body_cam.linear();
+  const Eigen::Vector3d o = c.T_body_cam.translation();
+  // 2 x 2 supersampling: the paint's edges are anti-aliased.
+  for (int v = 0; v < image.rows; ++v) {
+    for (int u = 0; u < image.cols; ++u) {
+      double sum = 0.0;
+      for (double du : {-0.25, 0.25}) {
+        for (double dv : {-0.25, 0.25}) {
+          const Eigen::Vector3d ray =
+              R * Eigen::Vector3d((u + du - 320.0) / 550.0,
+                                  (v + dv - 240.0) / 550.0, 1.0);
+          if (ray.z() <= 0) continue;
+          const double t = (1.0 - o.z()) / ray.z();
+          const Eigen::Vector3d p = o + t * ray;
+          sum += 0.25 * (90.0 + 120.0 * Paint(p.x(), p.y()));
+        }
+      }
+      image.at<float>(v, u) = static_cast<float>(sum);
+    }
+  }
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.6);
+  cv::Mat noise(image.size(), CV_32F);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 3.0);
+  return image + noise;
+}
+
+TEST(StereoLineExtractor, RecoversLanesAndStopLineNotTheZebra) {
+  const RigCamera left = MakeCamera("left", -0.5);
+  const RigCamera right = MakeCamera("right", 0.5);
+  RoadPlane road;
+  road.offset_m = 1.0;
+  const StereoLineExtractor extractor(left, right, road, RoadLineOptions());
+  ASSERT_TRUE(extractor.ok()) << extractor.error();
+  const PairLines result = extractor.Extract(Render(left, 1), Render(right, 2));
+  int solid = 0, dashed = 0, stop = 0;
+  for (const RoadLine3d& line : result.lines) {
+    ASSERT_EQ(line.points_body.size(), line.covariances_body.size());
+    ASSERT_EQ(line.points_body.size(), line.uv_left.size());
+    for (size_t k = 0; k < line.points_body.size(); ++k) {
+      const Eigen::Vector3d& p = line.points_body[k];
+      const Eigen::Matrix3d& c = line.covariances_body[k];
+      SCOPED_TRACE(::testing::Message()
+                   << RoadLineTypeName(line.type) << " at " << p.transpose());
+      // Never inside the zebra crossing.
+      EXPECT_FALSE(p.x() > 12.9 && p.x() < 16.1);
+      if (line.type == RoadLineType::kStopLine) {
+        EXPECT_NEAR(p.x(), 11.0, 0.04);
+        EXPECT_NEAR(p.z(), 1.0, 1e-6);  // on the plane by construction
+        continue;
+      }
+      // The solid line, or the dashes (a dash cut by the image border is
+      // "solid": only the database can tell).
+      const double truth_y = p.y() < 0.0 ? -1.8 : 1.6;
+      EXPECT_NEAR(p.y(), truth_y, 0.03);
+      // Height from stereo, within 3 sigma of its own covariance (and a
+      // few centimetres).
+      EXPECT_NEAR(p.z(), 1.0, std::max(0.01, 3.0 * std::sqrt(c(2, 2))));
+      EXPECT_LT(std::sqrt(c(2, 2)), 0.05);
+      EXPECT_GT(c.determinant(), 0.0);
+    }
+    const bool left_side = line.points_body[0].y() < 0.0;
+    solid += line.type == RoadLineType::kLaneSolid && left_side;
+    dashed += line.type == RoadLineType::kLaneDashed && !left_side;
+    stop += line.type == RoadLineType::kStopLine;
+  }
+  EXPECT_GE(solid, 1);
+  EXPECT_GE(dashed, 1);
+  EXPECT_EQ(stop, 1);
+  EXPECT_GT(result.wide_runs, 50);  // the zebra bands, seen and left out
+}
+
+}  // namespace
+}  // namespace zebrageo
