@@ -595,6 +595,14 @@ void EvaluateControlPoints(const AdjustmentOptions& options, const Rig& rig,
 }
 
 
+// 95% quantile of the chi-square distribution with k degrees of freedom
+// (Wilson-Hilferty; within 1% for k >= 1).
+double ChiSquare95(int k) {
+  const double a = 2.0 / (9.0 * k);
+  const double c = 1.0 - a + 1.6448536 * std::sqrt(a);
+  return k * c * c * c;
+}
+
 // Variance component of the GNSS/INS position prior, from the data: each
 // control crossing's discrepancy (database minus image-only position with
 // the INS trajectory, median over its vertices) holds the drift there plus
@@ -624,6 +632,7 @@ Eigen::Vector2d EstimateGnssSigma(const AdjustmentOptions& options,
     sigma2[p.crossing] += p.sigma_m.cwiseAbs2() + covariance.diagonal();
   }
   double sum_h = 0.0, sum_v = 0.0, database_h = 0.0, database_v = 0.0;
+  double test_h = 0.0, test_v = 0.0;  // sum of squared normalised residuals
   int n = 0;
   const double offset2 =
       options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
@@ -640,15 +649,26 @@ Eigen::Vector2d EstimateGnssSigma(const AdjustmentOptions& options,
     sum_h += 0.5 * median.head<2>().squaredNorm();
     sum_v += median.z() * median.z();
     const Eigen::Vector3d mean_sigma2 = sigma2[c] / (m * m);
-    database_h += offset2 + 0.5 * (mean_sigma2.x() + mean_sigma2.y());
-    database_v += offset2 + mean_sigma2.z();
+    const double variance_h =
+        offset2 + 0.5 * (mean_sigma2.x() + mean_sigma2.y());
+    const double variance_v = offset2 + mean_sigma2.z();
+    database_h += variance_h;
+    database_v += variance_v;
+    test_h += median.head<2>().squaredNorm() / variance_h;
+    test_v += median.z() * median.z() / variance_v;
     ++n;
   }
   if (n == 0) return upper;
   const double floor2 = options.min_gnss_sigma_m * options.min_gnss_sigma_m;
+  // A drift is estimated only where the discrepancies exceed what the
+  // database's error explains (chi-square test at 95%): with one or two
+  // crossings the mean square is too noisy to trust on its own.
+  const bool drift_h = test_h > ChiSquare95(2 * n);
+  const bool drift_v = test_v > ChiSquare95(n);
   const Eigen::Vector2d estimate(
-      std::sqrt(std::max(floor2, (sum_h - database_h) / n)),
-      std::sqrt(std::max(floor2, (sum_v - database_v) / n)));
+      std::sqrt(drift_h ? std::max(floor2, (sum_h - database_h) / n) : floor2),
+      std::sqrt(drift_v ? std::max(floor2, (sum_v - database_v) / n)
+                        : floor2));
   return estimate.cwiseMin(upper);
 }
 }  // namespace
