@@ -280,7 +280,9 @@ struct KnownEnd {
   const PlaneLine* expected = nullptr;
 };
 
-enum class BandOutcome { kBand, kRejected, kNoTransversal };
+// kNoTransversal: no transversal side at an end; kDisagreement: the two
+// images disagree (a vehicle hides an end in one of them).
+enum class BandOutcome { kBand, kRejected, kNoTransversal, kDisagreement };
 
 double MedianOf(std::vector<double> values) {
   const size_t mid = values.size() / 2;
@@ -1298,7 +1300,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     }
     if (disagreement > options.max_stereo_disagreement_m) {
       VLOG(2) << "band " << i << ": stereo disagreement " << disagreement;
-      return BandOutcome::kRejected;
+      return BandOutcome::kDisagreement;
     }
     const Eigen::Vector3d& v0 = band.vertices_body[0];
     const Eigen::Vector3d& v1 = band.vertices_body[1];
@@ -1381,7 +1383,8 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     Band band;
     const BandOutcome outcome = model_band(i, none, &band);
     if (outcome == BandOutcome::kBand) bands.push_back(band);
-    if (outcome == BandOutcome::kNoTransversal) {
+    if (outcome == BandOutcome::kNoTransversal ||
+        outcome == BandOutcome::kDisagreement) {
       without_transversal.push_back(i);
     }
   }
@@ -1392,6 +1395,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   // end; fitted on the vertices of its fully seen bands, that line gives
   // the hidden end when it is reliable: enough bands, small residuals, a
   // band next to them. The band's seen end must lie on the other line.
+  // (An end hidden in one image only makes the two images disagree.)
   std::vector<std::array<PlaneLine, 2>> lines(crossings);
   std::vector<std::array<double, 2>> line_sigma(crossings, {-1.0, -1.0});
   std::vector<std::array<double, 2>> line_rms(crossings, {-1.0, -1.0});
