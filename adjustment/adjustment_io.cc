@@ -71,7 +71,8 @@ nlohmann::json SummaryJson(const AdjustmentData& data,
   j["check_rmse_m"] = {{"horizontal", s.check_rmse_horizontal_m},
                        {"vertical", s.check_rmse_vertical_m},
                        {"vertices", s.num_check_points},
-                       {"crossings", s.num_check_crossings}};
+                       {"crossings", s.num_check_crossings},
+                       {"held_out_then_control", s.check_points_in_final}};
   j["correction_m"] = {{"max_horizontal", s.max_correction_horizontal_m},
                        {"max_vertical", s.max_correction_vertical_m},
                        {"rms_horizontal", s.rms_correction_horizontal_m}};
@@ -102,8 +103,10 @@ nlohmann::json SummaryJson(const AdjustmentData& data,
   j["rig"] = rig;
   j["model"] = {
       {"knot_spacing_s", options.knot_spacing_s},
-      {"gnss_sigma_horizontal_m", options.gnss_sigma_horizontal_m},
-      {"gnss_sigma_vertical_m", options.gnss_sigma_vertical_m},
+      {"gnss_sigma_horizontal_m", s.gnss_sigma_horizontal_m},
+      {"gnss_sigma_vertical_m", s.gnss_sigma_vertical_m},
+      {"gnss_sigma_estimated", options.estimate_gnss_sigma},
+      {"prior_correlation_time_s", options.prior_correlation_time_s},
       {"ins_attitude_sigma_deg", options.ins_attitude_sigma_deg},
       {"drift_rate_sigma_mps", options.drift_rate_sigma_mps},
       {"drift_acceleration_sigma_mps2", options.drift_acceleration_sigma_mps2},

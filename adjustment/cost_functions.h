@@ -272,95 +272,61 @@ struct PointPriorError {
   Eigen::Matrix3d sqrt_information;
 };
 
+// ceres::SizedCostFunction<M, M, ..., M> with N parameter blocks of size M.
+template <int M, int N, int... Sizes>
+struct RepeatedBlocksCostFunction
+    : RepeatedBlocksCostFunction<M, N - 1, M, Sizes...> {};
+template <int M, int... Sizes>
+struct RepeatedBlocksCostFunction<M, 0, Sizes...> {
+  using type = ceres::SizedCostFunction<M, Sizes...>;
+};
+
 // A whitened linear combination of N parameter blocks of size M:
 //   r = S (sum_j a_j x_j - b)
 // The trajectory priors are of this form, on knots (M = 6):
-//   GNSS/INS absolute:  a = {1},         b = 0 (the INS solution itself)
+//   GNSS/INS absolute:  a = {1},         b = the INS solution's jumps (or 0)
 //   drift rate:         a = {-1, 1}      (k_{i+1} - k_i)
 //   drift rate change:  a = {1, -2, 1}   (second difference)
 // and the crossing-offset and rig-correction priors (N = 1). Analytic
 // Jacobians: dr/dx_j = a_j S.
 template <int N, int M>
-class LinearPrior;
-
-template <int M>
-class LinearPrior<1, M> : public ceres::SizedCostFunction<M, M> {
+class LinearPrior : public RepeatedBlocksCostFunction<M, N>::type {
  public:
+  static_assert(N >= 1 && M >= 1, "LinearPrior needs N, M >= 1");
   using Matrix = Eigen::Matrix<double, M, M>;
   using Vector = Eigen::Matrix<double, M, 1>;
-  LinearPrior(const Matrix& sqrt_information, const Vector& b)
-      : S_(sqrt_information), b_(b) {}
+  LinearPrior(const Matrix& sqrt_information, const std::array<double, N>& a,
+              const Vector& b = Vector::Zero())
+      : S_(sqrt_information), a_(a), b_(b) {}
+
+  // Owned by the caller (Ceres' problem takes ownership when added).
+  static ceres::CostFunction* Create(const Matrix& sqrt_information,
+                                     const std::array<double, N>& a,
+                                     const Vector& b = Vector::Zero()) {
+    return new LinearPrior(sqrt_information, a, b);
+  }
+
   bool Evaluate(double const* const* x, double* residuals,
                 double** jacobians) const override {
+    Vector sum = -b_;
+    for (int j = 0; j < N; ++j) sum += a_[j] * Eigen::Map<const Vector>(x[j]);
     Eigen::Map<Vector> r(residuals);
-    r = S_ * (Eigen::Map<const Vector>(x[0]) - b_);
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, M, M, Eigen::RowMajor>> J(jacobians[0]);
-      J = S_;
+    r = S_ * sum;
+    if (jacobians != nullptr) {
+      for (int j = 0; j < N; ++j) {
+        if (jacobians[j] == nullptr) continue;
+        Eigen::Map<Eigen::Matrix<double, M, M, Eigen::RowMajor>> J(
+            jacobians[j]);
+        J = a_[j] * S_;
+      }
     }
     return true;
   }
 
  private:
   Matrix S_;
+  std::array<double, N> a_;
   Vector b_;
-};
-
-template <int M>
-class LinearPrior<2, M> : public ceres::SizedCostFunction<M, M, M> {
- public:
-  using Matrix = Eigen::Matrix<double, M, M>;
-  using Vector = Eigen::Matrix<double, M, 1>;
-  LinearPrior(const Matrix& sqrt_information, const std::array<double, 2>& a)
-      : S_(sqrt_information), a_(a) {}
-  bool Evaluate(double const* const* x, double* residuals,
-                double** jacobians) const override {
-    Eigen::Map<Vector> r(residuals);
-    r = S_ * (a_[0] * Eigen::Map<const Vector>(x[0]) +
-              a_[1] * Eigen::Map<const Vector>(x[1]));
-    if (jacobians != nullptr) {
-      for (int j = 0; j < 2; ++j) {
-        if (jacobians[j] == nullptr) continue;
-        Eigen::Map<Eigen::Matrix<double, M, M, Eigen::RowMajor>> J(
-            jacobians[j]);
-        J = a_[j] * S_;
-      }
-    }
-    return true;
-  }
-
- private:
-  Matrix S_;
-  std::array<double, 2> a_;
-};
-
-template <int M>
-class LinearPrior<3, M> : public ceres::SizedCostFunction<M, M, M, M> {
- public:
-  using Matrix = Eigen::Matrix<double, M, M>;
-  using Vector = Eigen::Matrix<double, M, 1>;
-  LinearPrior(const Matrix& sqrt_information, const std::array<double, 3>& a)
-      : S_(sqrt_information), a_(a) {}
-  bool Evaluate(double const* const* x, double* residuals,
-                double** jacobians) const override {
-    Eigen::Map<Vector> r(residuals);
-    r = S_ * (a_[0] * Eigen::Map<const Vector>(x[0]) +
-              a_[1] * Eigen::Map<const Vector>(x[1]) +
-              a_[2] * Eigen::Map<const Vector>(x[2]));
-    if (jacobians != nullptr) {
-      for (int j = 0; j < 3; ++j) {
-        if (jacobians[j] == nullptr) continue;
-        Eigen::Map<Eigen::Matrix<double, M, M, Eigen::RowMajor>> J(
-            jacobians[j]);
-        J = a_[j] * S_;
-      }
-    }
-    return true;
-  }
-
- private:
-  Matrix S_;
-  std::array<double, 3> a_;
 };
 
 }  // namespace zebrageo

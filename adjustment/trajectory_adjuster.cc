@@ -62,6 +62,13 @@ struct ControlPoint {
   ControlStatus status = ControlStatus::kControl;
   Eigen::Vector3d estimate = Eigen::Vector3d::Zero();  // parameter block
   double normalized_residual = 0.0;
+  // A check point held out of a first adjustment, then used as control in
+  // the final one: its image-only position in the first.
+  bool held_out = false;
+  bool held_out_triangulated = false;
+  Eigen::Vector3d held_out_enu = Eigen::Vector3d::Zero();
+  double held_out_rms_px = 0.0;
+  double held_out_normalized_residual = 0.0;
 };
 
 struct TiePoint {
@@ -82,6 +89,8 @@ struct State {
   // Centre of the GNSS/INS prior of each knot: 0, or the jumps removed
   // from the trajectory before the knot (track frame).
   std::vector<Eigen::Matrix<double, 6, 1>> knot_prior;
+  // GNSS/INS position sigma (horizontal, vertical) of the prior.
+  Eigen::Vector2d gnss_sigma_m = Eigen::Vector2d::Ones();
 };
 
 // The camera's mounting after its correction.
@@ -386,22 +395,38 @@ class AdjustmentProblem {
 
     // GNSS/INS absolute: attitude and position as separate blocks so the
     // Cauchy loss of a GNSS jump does not switch off the attitude.
+    // The GNSS/INS error is one smooth drift, correlated over
+    // prior_correlation_time_s: the prior's sigma holds once per correlation
+    // time, not once per knot (which would pin the mean correction to
+    // sigma / sqrt(knots)).
+    const double widen = std::sqrt(
+        std::max(1.0, options_.prior_correlation_time_s / dt));
     Eigen::Matrix<double, 6, 6> S_att = Eigen::Matrix<double, 6, 6>::Zero();
     S_att.diagonal().head<3>().setConstant(
         1.0 / (options_.ins_attitude_sigma_deg * kDegToRad));
     Eigen::Matrix<double, 6, 6> S_pos = Eigen::Matrix<double, 6, 6>::Zero();
     S_pos.diagonal().tail<3>() =
-        Eigen::Vector3d(1.0 / options_.gnss_sigma_horizontal_m,
-                        1.0 / options_.gnss_sigma_horizontal_m,
-                        1.0 / options_.gnss_sigma_vertical_m);
+        Eigen::Vector3d(1.0 / state_->gnss_sigma_m.x(),
+                        1.0 / state_->gnss_sigma_m.x(),
+                        1.0 / state_->gnss_sigma_m.y()) /
+        widen;
     const Eigen::Matrix<double, 6, 1> zero =
         Eigen::Matrix<double, 6, 1>::Zero();
     // Drift rate and its change.
     Eigen::Matrix<double, 6, 6> S_rate = Eigen::Matrix<double, 6, 6>::Zero();
     S_rate.diagonal().head<3>().setConstant(
         1.0 / (options_.drift_rate_sigma_deg_per_s * kDegToRad * dt));
-    S_rate.diagonal().tail<3>().setConstant(
-        1.0 / (options_.drift_rate_sigma_mps * dt));
+    // A drift of sigma correlated over tau (first-order Gauss-Markov) changes
+    // by sigma sqrt(2 dt / tau) per dt: a small drift is a slow one too, so
+    // the correction cannot make a local bump at each crossing either.
+    const double tau = options_.prior_correlation_time_s;
+    const Eigen::Vector2d rate_sigma =
+        (state_->gnss_sigma_m * std::sqrt(2.0 / (tau * dt)))
+            .cwiseMin(options_.drift_rate_sigma_mps);
+    S_rate.diagonal().tail<3>() =
+        Eigen::Vector3d(1.0 / rate_sigma.x(), 1.0 / rate_sigma.x(),
+                        1.0 / rate_sigma.y()) /
+        dt;
     Eigen::Matrix<double, 6, 6> S_acc = Eigen::Matrix<double, 6, 6>::Zero();
     S_acc.diagonal().head<3>().setConstant(
         1.0 / (options_.drift_angular_acceleration_sigma_deg_per_s2 *
@@ -411,18 +436,18 @@ class AdjustmentProblem {
     for (int k = 0; k < n; ++k) {
       const Eigen::Matrix<double, 6, 1>& b =
           state_->knot_prior.empty() ? zero : state_->knot_prior[k];
-      problem_->AddResidualBlock(new LinearPrior<1, 6>(S_att, b), nullptr,
+      problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S_att, {1.0}, b), nullptr,
                                  knots[k].data());
       blocks_.gnss.push_back(problem_->AddResidualBlock(
-          new LinearPrior<1, 6>(S_pos, b), gnss_loss_.get(), knots[k].data()));
+          LinearPrior<1, 6>::Create(S_pos, {1.0}, b), gnss_loss_.get(), knots[k].data()));
       if (k + 1 < n) {
-        problem_->AddResidualBlock(new LinearPrior<2, 6>(S_rate, {-1.0, 1.0}),
+        problem_->AddResidualBlock(LinearPrior<2, 6>::Create(S_rate, {-1.0, 1.0}),
                                    nullptr, knots[k].data(),
                                    knots[k + 1].data());
       }
       if (k + 2 < n) {
         problem_->AddResidualBlock(
-            new LinearPrior<3, 6>(S_acc, {1.0, -2.0, 1.0}), nullptr,
+            LinearPrior<3, 6>::Create(S_acc, {1.0, -2.0, 1.0}), nullptr,
             knots[k].data(), knots[k + 1].data(), knots[k + 2].data());
       }
     }
@@ -435,7 +460,7 @@ class AdjustmentProblem {
         S.diagonal().head<3>().setConstant(
             1.0 / (options_.boresight_sigma_deg * kDegToRad));
         S.diagonal().tail<3>().setConstant(1.0 / options_.lever_arm_sigma_m);
-        problem_->AddResidualBlock(new LinearPrior<1, 6>(S, zero), nullptr,
+        problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S, {1.0}), nullptr,
                                    r.data());
         ++num_pose_blocks_;
       }
@@ -454,9 +479,9 @@ class AdjustmentProblem {
           // match, a repainted crossing) moves its own offset, not the
           // trajectory; the blunder test then rejects it.
           problem_->AddResidualBlock(
-              new LinearPrior<1, 3>(Eigen::Matrix3d::Identity() /
-                                        options_.crossing_offset_sigma_m,
-                                    Eigen::Vector3d::Zero()),
+              LinearPrior<1, 3>::Create(Eigen::Matrix3d::Identity() /
+                                            options_.crossing_offset_sigma_m,
+                                        {1.0}),
               control_loss_.get(), offset);
           ++num_pose_blocks_;
         } else {
@@ -583,6 +608,63 @@ void EvaluateControlPoints(const AdjustmentOptions& options, const Rig& rig,
   }
 }
 
+
+// Variance component of the GNSS/INS position prior, from the data: each
+// control crossing's discrepancy (database minus image-only position with
+// the INS trajectory, median over its vertices) holds the drift there plus
+// the database's own error (crossing offset, vertex noise). The mean square
+// discrepancy minus the database's share estimates the drift's variance,
+// clamped to [min_gnss_sigma_m, gnss_sigma_*]. Returns (horizontal per
+// axis, vertical).
+Eigen::Vector2d EstimateGnssSigma(const AdjustmentOptions& options,
+                                  const Rig& rig, const State& state,
+                                  int num_crossings) {
+  const Eigen::Vector2d upper(options.gnss_sigma_horizontal_m,
+                              options.gnss_sigma_vertical_m);
+  if (!options.estimate_gnss_sigma) return upper;
+  std::vector<std::vector<Eigen::Vector3d>> d(num_crossings);
+  std::vector<Eigen::Vector3d> sigma2(num_crossings, Eigen::Vector3d::Zero());
+  for (const ControlPoint& p : state.points) {
+    if (p.status != ControlStatus::kControl) continue;
+    Eigen::Vector3d X;
+    Eigen::Matrix3d covariance;
+    double rms_px = 0.0;
+    if (!TriangulateWithState(rig, state, p.observations, p.database_enu,
+                              options.vertex_sigma_px, &X, &covariance,
+                              &rms_px)) {
+      continue;
+    }
+    d[p.crossing].push_back(p.database_enu - X);
+    sigma2[p.crossing] += p.sigma_m.cwiseAbs2() + covariance.diagonal();
+  }
+  double sum_h = 0.0, sum_v = 0.0, database_h = 0.0, database_v = 0.0;
+  int n = 0;
+  const double offset2 =
+      options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
+  for (int c = 0; c < num_crossings; ++c) {
+    const int m = static_cast<int>(d[c].size());
+    if (m == 0) continue;
+    Eigen::Vector3d median;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> values;
+      for (const Eigen::Vector3d& v : d[c]) values.push_back(v[axis]);
+      std::nth_element(values.begin(), values.begin() + m / 2, values.end());
+      median[axis] = values[m / 2];
+    }
+    sum_h += 0.5 * median.head<2>().squaredNorm();
+    sum_v += median.z() * median.z();
+    const Eigen::Vector3d mean_sigma2 = sigma2[c] / (m * m);
+    database_h += offset2 + 0.5 * (mean_sigma2.x() + mean_sigma2.y());
+    database_v += offset2 + mean_sigma2.z();
+    ++n;
+  }
+  if (n == 0) return upper;
+  const double floor2 = options.min_gnss_sigma_m * options.min_gnss_sigma_m;
+  const Eigen::Vector2d estimate(
+      std::sqrt(std::max(floor2, (sum_h - database_h) / n)),
+      std::sqrt(std::max(floor2, (sum_v - database_v) / n)));
+  return estimate.cwiseMin(upper);
+}
 }  // namespace
 
 const char* ControlStatusName(ControlStatus status) {
@@ -608,6 +690,8 @@ std::string AdjustmentOptions::Check() const {
       {"gnss_sigma_vertical_m", gnss_sigma_vertical_m},
       {"gnss_loss_scale", gnss_loss_scale},
       {"ins_attitude_sigma_deg", ins_attitude_sigma_deg},
+      {"prior_correlation_time_s", prior_correlation_time_s},
+      {"min_gnss_sigma_m", min_gnss_sigma_m},
       {"drift_rate_sigma_mps", drift_rate_sigma_mps},
       {"drift_rate_sigma_deg_per_s", drift_rate_sigma_deg_per_s},
       {"drift_acceleration_sigma_mps2", drift_acceleration_sigma_mps2},
@@ -903,6 +987,11 @@ AdjustmentResult AdjustTrajectory(
   }
 
   // ------------------------------------------------------------ solve
+  state.gnss_sigma_m = EstimateGnssSigma(options, rig, state, num_crossings);
+  summary.gnss_sigma_horizontal_m = state.gnss_sigma_m.x();
+  summary.gnss_sigma_vertical_m = state.gnss_sigma_m.y();
+  LOG(INFO) << "adjustment: GNSS/INS prior sigma " << state.gnss_sigma_m.x()
+            << " m horizontal, " << state.gnss_sigma_m.y() << " m vertical";
   const StateRms before = MeasureState(rig, state);
   const int total_solves = 2 + options.max_blunder_iterations;
   auto solve = [&](bool robust) -> std::unique_ptr<AdjustmentProblem> {
@@ -920,10 +1009,18 @@ AdjustmentResult AdjustTrajectory(
     return problem;
   };
   std::unique_ptr<AdjustmentProblem> problem;
-  if (has_control || !state.ties.empty() || !state.lines.empty()) {
+  // Back to the INS and the database, so a removed point leaves no trace.
+  auto reset = [&state]() {
+    for (Knot& k : state.correction.knots()) k.fill(0.0);
+    for (Eigen::Vector3d& o : state.crossing_offsets) o.setZero();
+    for (ControlPoint& p : state.points) p.estimate = p.database_enu;
+  };
+  // The adjustment with its blunder loop; false (summary.message set) when
+  // it fails.
+  auto adjust = [&]() -> bool {
     // Least squares first (the drift makes every observation look like an
     // outlier at the start), then robustly.
-    if (!(problem = solve(false)) || !(problem = solve(true))) return result;
+    if (!(problem = solve(false)) || !(problem = solve(true))) return false;
     for (int iteration = 0; iteration < options.max_blunder_iterations;
          ++iteration) {
       EvaluateControlPoints(options, rig, &state);
@@ -984,15 +1081,39 @@ AdjustmentResult AdjustTrajectory(
         summary.message =
             "every control point was rejected as a blunder: the control "
             "disagrees with the trajectory and with itself";
-        return result;
+        return false;
       }
-      // Start again from the INS so a blunder leaves no trace.
-      for (Knot& k : state.correction.knots()) k.fill(0.0);
-      for (Eigen::Vector3d& o : state.crossing_offsets) o.setZero();
-      for (ControlPoint& p : state.points) p.estimate = p.database_enu;
-      if (!(problem = solve(false)) || !(problem = solve(true))) return result;
+      reset();
+      if (!(problem = solve(false)) || !(problem = solve(true))) return false;
     }
     summary.sigma0 = problem->Sigma0();
+    return true;
+  };
+  if (has_control || !state.ties.empty() || !state.lines.empty()) {
+    const bool any_check =
+        std::any_of(state.points.begin(), state.points.end(),
+                    [](const ControlPoint& p) {
+                      return p.status == ControlStatus::kCheck;
+                    });
+    if (!adjust()) return result;
+    if (any_check && options.check_points_in_final) {
+      // The check points' residuals are those of this adjustment, which
+      // did not see them; the final adjustment then uses every crossing.
+      EvaluateControlPoints(options, rig, &state);
+      for (ControlPoint& p : state.points) {
+        if (p.status != ControlStatus::kCheck) continue;
+        p.held_out = true;
+        p.held_out_normalized_residual = p.normalized_residual;
+        Eigen::Matrix3d covariance;
+        p.held_out_triangulated = TriangulateWithState(
+            rig, state, p.observations, p.database_enu,
+            options.vertex_sigma_px, &p.held_out_enu, &covariance,
+            &p.held_out_rms_px);
+        p.status = ControlStatus::kControl;
+      }
+      reset();
+      if (!adjust()) return result;
+    }
   }
   EvaluateControlPoints(options, rig, &state);
   const StateRms after = MeasureState(rig, state);
@@ -1149,7 +1270,15 @@ AdjustmentResult AdjustTrajectory(
     result.bands.push_back(band);
   }
 
-  // Control and check points.
+  // Control and check points. Held-out check points are reported with their
+  // residuals from the adjustment that did not see them.
+  for (ControlPoint& p : state.points) {
+    if (p.held_out && p.status == ControlStatus::kControl) {
+      p.status = ControlStatus::kCheck;
+      p.normalized_residual = p.held_out_normalized_residual;
+      summary.check_points_in_final = true;
+    }
+  }
   std::vector<double> control_h, control_v, check_h, check_v;
   for (ControlPoint& p : state.points) {
     ControlPointResult r;
@@ -1163,10 +1292,19 @@ AdjustmentResult AdjustTrajectory(
     Eigen::Matrix3d covariance;
     double rms_px = 0.0;
     Eigen::Vector3d X;
-    const bool triangulated = TriangulateWithState(
-        rig, state, p.observations,
-        p.status == ControlStatus::kControl ? p.estimate : p.database_enu,
-        options.vertex_sigma_px, &X, &covariance, &rms_px);
+    const bool from_held_out = p.held_out && p.status == ControlStatus::kCheck;
+    if (from_held_out) {
+      X = p.held_out_enu;
+      rms_px = p.held_out_rms_px;
+    }
+    const bool triangulated =
+        from_held_out ? p.held_out_triangulated
+                      : TriangulateWithState(
+                            rig, state, p.observations,
+                            p.status == ControlStatus::kControl
+                                ? p.estimate
+                                : p.database_enu,
+                            options.vertex_sigma_px, &X, &covariance, &rms_px);
     r.image_enu = triangulated ? X : p.database_enu;
     if (p.status == ControlStatus::kControl) {
       r.adjusted_enu = p.estimate;

@@ -14,17 +14,25 @@
 //   - the database position of each control vertex (sigma_xy, sigma_z of
 //     the database) plus its crossing's offset (crossing_offset_sigma_m),
 //     Cauchy loss;
-//   - the GNSS/INS solution: the correction at each knot is 0 +- gnss_*
-//     (Cauchy loss: a GNSS jump is an outlier, not a constraint);
-//   - the INS relative motion: the drift rate (first difference of knots)
-//     and its change (second difference) are small; their sigmas set how
-//     fast the correction may vary between control points.
+//   - the GNSS/INS solution: the correction at each knot is 0 +- gnss_*,
+//     counted once per prior_correlation_time_s (Cauchy loss: a GNSS jump
+//     is an outlier, not a constraint); gnss_* are estimated from the
+//     control first (variance components: what the crossings' discrepancies
+//     hold beyond the database's own error), so a drift smaller than the
+//     database's error is not "corrected" into that error;
+//   - the INS relative motion: the drift rate (first difference of knots,
+//     at most what a Gauss-Markov drift of sigma gnss_* and correlation
+//     time prior_correlation_time_s allows) and its change (second
+//     difference) are small; they set how fast the correction may vary
+//     between control points.
 // Solved with Ceres (SPARSE_SCHUR on SuiteSparse: points eliminated, the
 // banded knot system factorised), first without robust losses to take out
 // the drift, then robustly; then control vertices whose image-only position
 // disagrees with the database (normalised residual above
 // blunder_threshold) are removed and the adjustment repeated. A share of
-// crossings is held out as check points: evaluated, never adjusted.
+// crossings is held out as check points: their residuals come from an
+// adjustment without them; the final adjustment then uses them as control
+// (check_points_in_final).
 #ifndef ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 #define ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 
@@ -61,9 +69,20 @@ struct AdjustmentOptions {
   double gnss_sigma_horizontal_m = 1.0;
   double gnss_sigma_vertical_m = 1.0;
   double gnss_loss_scale = 1.0;
+  // Variance component estimation of the two sigmas above (upper bounds
+  // then): the mean square discrepancy between the control crossings and
+  // the INS trajectory, minus the database's own error. A drift the control
+  // does not show beyond the database's error is then not "corrected" into
+  // that error (an adjustment must not make the trajectory worse).
+  bool estimate_gnss_sigma = true;
+  double min_gnss_sigma_m = 0.03;
   // The INS absolute attitude, per knot (heading and tilt drift of a
   // tactical-grade INS: a few hundredths of a degree to a tenth).
   double ins_attitude_sigma_deg = 0.2;
+  // Correlation time of the GNSS/INS error (its drift): the two priors
+  // above hold once per this time, so each knot's prior is widened by
+  // sqrt(prior_correlation_time_s / knot_spacing_s).
+  double prior_correlation_time_s = 30.0;
   // Drift rate: how fast the position/attitude error may change (first
   // difference of knots / spacing), per knot interval.
   double drift_rate_sigma_mps = 0.2;
@@ -99,6 +118,11 @@ struct AdjustmentOptions {
   // crossing in time order), as long as min_control_crossings remain.
   double check_crossing_share = 0.2;
   int min_control_crossings = 3;
+  // Check crossings are held out of a first adjustment, which gives their
+  // residuals (the honest accuracy), then the final adjustment uses every
+  // crossing as control (the result is not weakened by the check). False:
+  // check crossings stay out of the result.
+  bool check_points_in_final = true;
 
   // ---------------------------------------------------- blunders
   // A control vertex is rejected when its normalised residual (image-only
@@ -201,6 +225,9 @@ struct AdjustmentSummary {
   int num_rejected_points = 0;
   int num_control_crossings = 0;
   int num_check_crossings = 0;
+  // The check points were held out of a first adjustment only (their
+  // residuals are from it) and are control in the final one.
+  bool check_points_in_final = false;
   int num_tie_tracks = 0;
   int num_residuals = 0;
   std::vector<ObservationRms> rms;
@@ -210,6 +237,9 @@ struct AdjustmentSummary {
   double check_rmse_horizontal_m = 0.0;
   double check_rmse_vertical_m = 0.0;
   // Size of the correction applied to the trajectory samples.
+  // GNSS/INS position sigma of the prior (estimated or as configured).
+  double gnss_sigma_horizontal_m = 0.0;
+  double gnss_sigma_vertical_m = 0.0;
   double max_correction_horizontal_m = 0.0;
   double max_correction_vertical_m = 0.0;
   double rms_correction_horizontal_m = 0.0;

@@ -11,16 +11,35 @@
 //       survey with truth/ (true poses, 0.3 px / 1.5 cm noise), so `zebrageo
 //       adjust` can be scored before the reconstruction and registration
 //       stages work.
+//   adjustment_bench --score SURVEY RESULTS [--no-ties] [--threads N]
+//       A simulated survey with truth/ and its reconstruct + match outputs:
+//       runs the adjustment with the model of the first version (a GNSS/INS
+//       prior of 1 m on every knot, check crossings left out of the result)
+//       and with the current defaults (prior once per correlation time, its
+//       sigma estimated from the control, Gauss-Markov drift rate, check
+//       crossings held out of a first adjustment then control), and prints
+//       the camera pose errors against truth: all exposures, those between
+//       the first and the last control crossing, and those beyond (no
+//       control: extrapolation).
+//
+// Measured (2 cores shared with other jobs; presets of seed 1 unless said,
+// reconstruct + match of main at 3be4147, ORB tie points), H / V cm, att deg:
+//   urban  first model  all 13.3/11.1/0.063  (see the --score output below)
+//   (figures: bench/README or the closing note of issue 7)
 #include <glog/logging.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "adjustment/adjustment_io.h"
 #include "adjustment/synthetic_survey.h"
+#include "adjustment/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
 
 namespace zebrageo {
@@ -61,6 +80,151 @@ Errors Score(const SyntheticSurvey& survey,
   return e;
 }
 
+// Camera pose errors of `poses` against the truth trajectory, split by
+// time: [inside_begin, inside_end] (between control crossings) and outside.
+struct SplitErrors {
+  Errors all, inside, outside;
+  int n_all = 0, n_inside = 0, n_outside = 0;
+};
+
+SplitErrors ScoreAgainstTruth(const Trajectory& truth, const Rig& rig,
+                              const std::vector<CameraPose>& poses,
+                              double inside_begin, double inside_end) {
+  double sums[3][3] = {};
+  int counts[3] = {};
+  for (const CameraPose& p : poses) {
+    Pose pose;
+    if (!truth.InterpolatePose(p.time, &pose)) continue;
+    const Eigen::Isometry3d T =
+        pose.T_enu_body() * rig.cameras[rig.FindCamera(p.camera)].T_body_cam;
+    const Eigen::Vector3d d = p.p_enu - T.translation();
+    const double angle =
+        Eigen::AngleAxisd(Eigen::Quaterniond(T.linear()).inverse() *
+                          p.q_enu_cam)
+            .angle() *
+        180.0 / M_PI;
+    const int part = p.time >= inside_begin && p.time <= inside_end ? 1 : 2;
+    for (int k : {0, part}) {
+      sums[k][0] += d.head<2>().squaredNorm();
+      sums[k][1] += d.z() * d.z();
+      sums[k][2] += angle * angle;
+      ++counts[k];
+    }
+  }
+  auto errors = [&](int k) {
+    Errors e;
+    if (counts[k] > 0) {
+      e.h = std::sqrt(sums[k][0] / counts[k]);
+      e.v = std::sqrt(sums[k][1] / counts[k]);
+      e.att = std::sqrt(sums[k][2] / counts[k]);
+    }
+    return e;
+  };
+  SplitErrors out;
+  out.all = errors(0);
+  out.inside = errors(1);
+  out.outside = errors(2);
+  out.n_all = counts[0];
+  out.n_inside = counts[1];
+  out.n_outside = counts[2];
+  return out;
+}
+
+int ScoreSurvey(const std::string& survey_folder,
+                const std::string& results_folder, bool ties, int threads) {
+  const AdjustmentData data = LoadAdjustmentData(survey_folder, results_folder);
+  const Trajectory truth(
+      ReadTrajectorySamples(survey_folder + "/truth/trajectory.csv",
+                            "truth/trajectory.csv"),
+      data.frame);
+  std::vector<TieTrack> tracks;
+  TiePointSummary tie_summary;
+  if (ties && data.missing_images == 0) {
+    tracks = BuildTieTracks(TiePointOptions(), data.survey_folder, data.rig,
+                            data.trajectory, data.exposures, &tie_summary);
+  }
+  std::map<int64_t, double> exposure_time;
+  for (const Exposure& e : data.exposures.exposures) {
+    exposure_time[e.exposure_id] = e.time;
+  }
+  struct Model {
+    const char* name;
+    AdjustmentOptions options;
+  };
+  AdjustmentOptions first;
+  first.estimate_gnss_sigma = false;
+  first.prior_correlation_time_s = first.knot_spacing_s;
+  first.check_points_in_final = false;
+  const std::vector<Model> models = {{"first model", first},
+                                     {"current", AdjustmentOptions()}};
+  std::printf("%s: %zu tie tracks\n", survey_folder.c_str(), tracks.size());
+  std::printf("%-12s | %-22s | %-22s | %-22s | %s\n", "model",
+              "all H/V cm, att deg", "between control", "beyond control",
+              "check RMSE H/V cm, prior sigma H/V m, rejected");
+  bool printed_before = false;
+  for (Model model : models) {
+    model.options.solver.num_threads = threads;
+    AdjustmentInput input = data.Input();
+    if (!tracks.empty()) input.tie_tracks = &tracks;
+    const AdjustmentResult result = AdjustTrajectory(model.options, input);
+    if (!result.summary.IsUsable()) {
+      std::printf("%-12s | NOT usable: %s\n", model.name,
+                  result.summary.message.c_str());
+      return 1;
+    }
+    // The span between the first and the last control crossing.
+    std::set<std::string> control;
+    for (const ControlPointResult& p : result.control_points) {
+      if (p.status != ControlStatus::kRejected) control.insert(p.crossing_id);
+    }
+    double begin = 1e300, end = -1e300;
+    for (const VertexMatch& m : data.matches) {
+      const auto t = exposure_time.find(m.exposure_id);
+      if (t == exposure_time.end() || control.count(m.crossing_id) == 0) {
+        continue;
+      }
+      begin = std::min(begin, t->second);
+      end = std::max(end, t->second);
+    }
+    if (!printed_before) {
+      std::vector<CameraPose> input_poses;
+      for (const ExposureImage& image : data.exposures.images) {
+        Pose pose;
+        if (!data.trajectory.InterpolatePose(image.time, &pose)) continue;
+        const Eigen::Isometry3d T =
+            pose.T_enu_body() * data.rig.cameras[image.camera].T_body_cam;
+        CameraPose c;
+        c.time = image.time;
+        c.camera = data.rig.cameras[image.camera].camera.name();
+        c.p_enu = T.translation();
+        c.q_enu_cam = Eigen::Quaterniond(T.linear());
+        input_poses.push_back(c);
+      }
+      const SplitErrors e =
+          ScoreAgainstTruth(truth, data.rig, input_poses, begin, end);
+      std::printf("%-12s | %6.1f %6.1f %7.3f | %6.1f %6.1f %7.3f | %6.1f "
+                  "%6.1f %7.3f |\n",
+                  "input", 100 * e.all.h, 100 * e.all.v, e.all.att,
+                  100 * e.inside.h, 100 * e.inside.v, e.inside.att,
+                  100 * e.outside.h, 100 * e.outside.v, e.outside.att);
+      printed_before = true;
+    }
+    const SplitErrors e =
+        ScoreAgainstTruth(truth, data.rig, result.camera_poses, begin, end);
+    const AdjustmentSummary& s = result.summary;
+    std::printf("%-12s | %6.1f %6.1f %7.3f | %6.1f %6.1f %7.3f | %6.1f %6.1f "
+                "%7.3f | %5.1f %5.1f, %5.2f %5.2f, %d\n",
+                model.name, 100 * e.all.h, 100 * e.all.v, e.all.att,
+                100 * e.inside.h, 100 * e.inside.v, e.inside.att,
+                100 * e.outside.h, 100 * e.outside.v, e.outside.att,
+                100 * s.check_rmse_horizontal_m, 100 * s.check_rmse_vertical_m,
+                s.gnss_sigma_horizontal_m, s.gnss_sigma_vertical_m,
+                s.num_rejected_points);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 int Main(int argc, char** argv) {
   int threads = 2;
   int ties = 0;
@@ -68,6 +232,8 @@ int Main(int argc, char** argv) {
   std::vector<int> sizes = {1000, 5000, 20000};
   std::vector<std::string> positional;
   bool observe = false;
+  bool score = false;
+  bool ties_in_score = true;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--threads" && i + 1 < argc) {
@@ -83,15 +249,27 @@ int Main(int argc, char** argv) {
       while (std::getline(list, item, ',')) sizes.push_back(std::stoi(item));
     } else if (arg == "--observe") {
       observe = true;
+    } else if (arg == "--score") {
+      score = true;
+    } else if (arg == "--no-ties") {
+      ties_in_score = false;
     } else if (arg == "-h" || arg == "--help") {
       std::printf(
           "usage: adjustment_bench [--threads N] [--sizes 1000,5000,20000] "
           "[--ties N]\n"
-          "       adjustment_bench --observe SURVEY RESULTS [--seed N]\n");
+          "       adjustment_bench --observe SURVEY RESULTS [--seed N]\n"
+          "       adjustment_bench --score SURVEY RESULTS [--no-ties]\n");
       return 0;
     } else {
       positional.push_back(arg);
     }
+  }
+  if (score) {
+    if (positional.size() != 2) {
+      std::fprintf(stderr, "--score needs SURVEY RESULTS\n");
+      return 2;
+    }
+    return ScoreSurvey(positional[0], positional[1], ties_in_score, threads);
   }
   if (observe) {
     if (positional.size() != 2) {

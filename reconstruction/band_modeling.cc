@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <sstream>
 
@@ -261,7 +262,28 @@ struct BandCandidate {
   // its set: a side may run on along a lane line, the overlap does not.
   double begin = 0.0;
   double end = 0.0;
+  // Completed band (see CompleteCrossings): which of lo (0) and hi (1) is
+  // inferred from the crossing rather than seen, -1 for none; the standard
+  // deviation of that inferred side across the band.
+  int inferred = -1;
+  double inferred_sigma_m = 0.0;
+  // A lone long side runs between its two sides.
+  bool edge_between = false;
 };
+
+// The transversal side of a band end taken from its crossing (hidden end).
+struct KnownEnd {
+  const PlaneLine* line = nullptr;
+  double sigma_m = 0.0;
+};
+
+enum class BandOutcome { kBand, kRejected, kNoTransversal };
+
+double MedianOf(std::vector<double> values) {
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
 
 // Union-find root.
 int Root(std::vector<int>* parent, int i) {
@@ -276,6 +298,213 @@ void Extent(const PlaneFrame& frame, const LongSide& side,
   const double b = frame.To2d(side.End()).dot(along);
   *low = std::min(a, b);
   *high = std::max(a, b);
+}
+
+
+// How far a transversal edge runs on beyond the band: the mean gradient
+// across `line` (with its polarity) beyond the band's long sides, from 10 %
+// to 50 % of the band width outside `ends` (the image vertices; `check`
+// says which side to look beyond), over the mean along the middle of the
+// band's end. About 0 for a band's painted end, much more for a shadow
+// boundary crossing the road. 0 when nothing beyond can be sampled.
+double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
+                        const Eigen::Vector2d ends[2], const bool check[2]) {
+  if (!(line.gamma.norm() > 0.0)) return 0.0;
+  const Eigen::Vector2d polarity = line.gamma.normalized();
+  const Eigen::Vector2d span = ends[1] - ends[0];
+  const double width = span.norm();
+  if (!(width > 2.0)) return 0.0;
+  const Eigen::Vector2d unit = span / width;
+  auto mean_between = [&](const Eigen::Vector2d& from, double t0, double t1,
+                          const Eigen::Vector2d& direction) {
+    double sum = 0.0;
+    int count = 0;
+    for (double t = t0; t <= t1; t += 1.0) {
+      const Eigen::Vector2d p = from + t * direction;
+      if (!edges.IsUsable(p.x(), p.y())) continue;
+      const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
+      sum += polarity.x() * g[0] + polarity.y() * g[1];
+      ++count;
+    }
+    return count >= 3 ? sum / count : std::nan("");
+  };
+  const double inside =
+      mean_between(ends[0], 0.2 * width, 0.8 * width, unit);
+  if (!(inside > 0.0)) return 0.0;
+  double run_on = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    if (!check[k]) continue;
+    const double outside = mean_between(ends[k], 0.1 * width, 0.5 * width,
+                                        k == 0 ? Eigen::Vector2d(-unit) : unit);
+    if (std::isfinite(outside)) run_on = std::max(run_on, outside / inside);
+  }
+  return run_on;
+}
+
+// Completes the crossings: a long side that no band took, lying where the
+// crossing's regular pattern expects a band side (one band width from the
+// slot of a missing band, with the polarity of that side), becomes a band
+// whose other side is inferred: the same direction, one median band width
+// of the crossing away. This recovers bands whose other side is hidden by
+// a parked vehicle or merged with a lane line painted across the band's
+// end. The transversal sides are still searched in both images, and the
+// band still has to pass every check after that; its inferred side gets
+// the spread of the crossing's widths as standard deviation.
+void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
+                       const BandOptions& options, int crossings,
+                       const std::vector<char>& side_used,
+                       std::vector<LongSide>* sides,
+                       std::vector<BandCandidate>* pairs,
+                       std::vector<int>* crossing_of) {
+  const int n = static_cast<int>(side_used.size());
+  const int m = static_cast<int>(pairs->size());
+  for (int c = 0; c < crossings; ++c) {
+    std::vector<double> centres, widths, contrasts, begins, ends;
+    int set = -1;
+    Eigen::Vector3d direction_body = Eigen::Vector3d::Zero();
+    Eigen::Vector2d along = Eigen::Vector2d::UnitX();
+    for (int i = 0; i < m; ++i) {
+      if ((*crossing_of)[i] != c) continue;
+      const LongSide& lo = (*sides)[(*pairs)[i].lo];
+      const LongSide& hi = (*sides)[(*pairs)[i].hi];
+      centres.push_back(0.5 * (lo.lateral_m + hi.lateral_m));
+      widths.push_back(hi.lateral_m - lo.lateral_m);
+      contrasts.push_back(std::abs(lo.contrast));
+      contrasts.push_back(std::abs(hi.contrast));
+      begins.push_back((*pairs)[i].begin);
+      ends.push_back((*pairs)[i].end);
+      set = lo.direction_set;
+      direction_body = lo.direction_body;
+      along = lo.direction_2d;
+    }
+    // A regular pattern needs a few bands to be trusted.
+    if (static_cast<int>(centres.size()) < options.completion_min_bands) {
+      continue;
+    }
+    std::sort(centres.begin(), centres.end());
+    const double width = MedianOf(widths);
+    double width_spread = 0.0;
+    for (double w : widths) width_spread += (w - width) * (w - width);
+    const double width_sigma =
+        std::max(options.completion_min_sigma_m,
+                 std::sqrt(width_spread / static_cast<double>(widths.size())));
+    // Band period: the median spacing of neighbouring bands, ignoring
+    // spacings across a missing band.
+    std::vector<double> spacings;
+    for (size_t k = 1; k < centres.size(); ++k) {
+      spacings.push_back(centres[k] - centres[k - 1]);
+    }
+    const double smallest = *std::min_element(spacings.begin(), spacings.end());
+    std::vector<double> regular;
+    for (double d : spacings) {
+      if (d < 1.5 * smallest) regular.push_back(d);
+    }
+    const double period = MedianOf(regular);
+    if (!(period > width + 0.2) ||
+        std::abs(width - zebra.band_width_m) > zebra.band_width_tolerance_m) {
+      continue;
+    }
+    bool irregular = false;
+    for (double d : regular) {
+      irregular = irregular || std::abs(d - period) > options.completion_tolerance_m;
+    }
+    if (irregular) continue;
+    const double begin = MedianOf(begins);
+    const double end = MedianOf(ends);
+    const double min_contrast = 0.5 * MedianOf(contrasts);
+    // Best side for each empty slot (index from the first band).
+    std::map<int, std::pair<double, int>> best;  // slot -> (residual, side)
+    for (int k = 0; k < n; ++k) {
+      const LongSide& s = (*sides)[k];
+      if (side_used[k] || s.direction_set != set) continue;
+      if (std::acos(std::min(1.0, std::abs(s.direction_body.dot(
+                                      direction_body)))) >
+          options.max_side_angle_rad) {
+        continue;
+      }
+      if (std::abs(s.contrast) < min_contrast) continue;
+      // Within the crossing along the band, and no longer than its bands (a
+      // lane line is).
+      double s0, s1;
+      Extent(frame, s, along, &s0, &s1);
+      if (s1 - s0 > end - begin + options.completion_tolerance_m * 5.0 ||
+          std::min(s1, end) - std::max(s0, begin) <
+              options.min_side_overlap_fraction * (s1 - s0)) {
+        continue;
+      }
+      // Paint brightens towards +lateral at the low side of a band.
+      const double centre =
+          s.lateral_m + (s.contrast > 0.0 ? 0.5 : -0.5) * width;
+      const double position = (centre - centres.front()) / period;
+      const int slot = static_cast<int>(std::lround(position));
+      const double residual = std::abs(position - slot) * period;
+      if (residual > options.completion_tolerance_m) continue;
+      // One slot beyond the outer bands at most; not an occupied slot.
+      const int last =
+          static_cast<int>(std::lround((centres.back() - centres.front()) /
+                                       period));
+      if (slot < -1 || slot > last + 1) continue;
+      bool occupied = false;
+      for (double x : centres) {
+        occupied = occupied ||
+                   std::abs(x - (centres.front() + slot * period)) < 0.5 * period;
+      }
+      if (occupied) continue;
+      auto it = best.find(slot);
+      if (it == best.end() || residual < it->second.first) {
+        best[slot] = {residual, k};
+      }
+    }
+    for (const auto& [slot, entry] : best) {
+      const int k = entry.second;
+      const LongSide seen = (*sides)[k];
+      LongSide other = seen;
+      const double shift = seen.contrast > 0.0 ? width : -width;
+      other.lateral_m = seen.lateral_m + shift;
+      other.point_body =
+          seen.point_body + shift * frame.Direction3d(seen.Normal2d());
+      other.contrast = -seen.contrast;
+      // The band plane is fitted on the seen side and the nearest band.
+      int nearest = -1;
+      double nearest_distance = 1e30;
+      for (int i = 0; i < m; ++i) {
+        if ((*crossing_of)[i] != c) continue;
+        const double d =
+            std::abs((*sides)[(*pairs)[i].lo].lateral_m - other.lateral_m);
+        if (d < nearest_distance) {
+          nearest_distance = d;
+          nearest = i;
+        }
+      }
+      other.support.clear();
+      for (int s : {(*pairs)[nearest].lo, (*pairs)[nearest].hi}) {
+        const std::vector<int>& support = (*sides)[s].support;
+        other.support.insert(other.support.end(), support.begin(),
+                             support.end());
+      }
+      const int index = static_cast<int>(sides->size());
+      sides->push_back(other);
+      BandCandidate candidate;
+      const bool seen_is_lo = seen.contrast > 0.0;
+      candidate.lo = seen_is_lo ? k : index;
+      candidate.hi = seen_is_lo ? index : k;
+      candidate.inferred = seen_is_lo ? 1 : 0;
+      candidate.inferred_sigma_m = std::hypot(
+          width_sigma,
+          seen.lateral_rms_m /
+              std::sqrt(static_cast<double>(std::max<size_t>(
+                  1, seen.support.size()))));
+      double s0, s1;
+      Extent(frame, seen, along, &s0, &s1);
+      candidate.begin = s0;
+      candidate.end = s1;
+      VLOG(2) << "crossing " << c << ": side " << k << " at "
+              << seen.lateral_m << " completes slot " << slot
+              << " (width " << width << ", period " << period << ")";
+      pairs->push_back(candidate);
+      crossing_of->push_back(c);
+    }
+  }
 }
 
 }  // namespace
@@ -334,6 +563,27 @@ std::string BandOptions::Check() const {
     error << "min_line_sigma_px = " << min_line_sigma_px << ": must be > 0";
   } else if (!(min_sigma_m > 0.0)) {
     error << "min_sigma_m = " << min_sigma_m << ": must be > 0";
+  } else if (completion_min_bands < 3) {
+    error << "completion_min_bands = " << completion_min_bands
+          << ": must be >= 3";
+  } else if (!(completion_tolerance_m > 0.0)) {
+    error << "completion_tolerance_m = " << completion_tolerance_m
+          << ": must be > 0";
+  } else if (!(completion_min_sigma_m > 0.0)) {
+    error << "completion_min_sigma_m = " << completion_min_sigma_m
+          << ": must be > 0";
+  } else if (!(inferred_score_factor > 0.0 && inferred_score_factor <= 1.0)) {
+    error << "inferred_score_factor = " << inferred_score_factor
+          << ": must be in (0, 1]";
+  } else if (!(max_transversal_run_on > 0.0)) {
+    error << "max_transversal_run_on = " << max_transversal_run_on
+          << ": must be > 0";
+  } else if (!(hidden_end_max_rms_m > 0.0)) {
+    error << "hidden_end_max_rms_m = " << hidden_end_max_rms_m
+          << ": must be > 0";
+  } else if (!(hidden_end_max_offset_m > 0.0)) {
+    error << "hidden_end_max_offset_m = " << hidden_end_max_offset_m
+          << ": must be > 0";
   }
   return error.str();
 }
@@ -563,7 +813,8 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                              const ZebraSpecification& zebra,
                              const BandOptions& options,
                              BandModelingDebug* debug) {
-  const std::vector<LongSide>& sides = detection.sides;
+  // Inferred sides (CompleteCrossings) are appended after the detected ones.
+  std::vector<LongSide> sides = detection.sides;
   const int n = static_cast<int>(sides.size());
 
   // 1. Pairs of long sides: parallel, one band width apart, overlapping,
@@ -593,10 +844,14 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
           options.min_side_overlap_fraction * std::min(a1 - a0, b1 - b0)) {
         continue;
       }
-      // Nothing between the two sides: the paint is one band (a side paired
-      // with the far edge of a lane line next to the band is not).
-      bool between = false;
-      for (int k = 0; k < n && !between; ++k) {
+      // The paint is one band: no gap of asphalt between the two sides, i.e.
+      // no side where the paint ends (darkening) followed by one where it
+      // starts again (a side paired with the far edge of a lane line next
+      // to the band is not a band). A lone edge between them is a shadow
+      // boundary running along the band: it must not hide the band.
+      double first_end = 1e30;
+      double last_start = -1e30;
+      for (int k = 0; k < n; ++k) {
         const LongSide& s = sides[k];
         if (k == i || k == j || s.direction_set != a.direction_set) continue;
         if (s.lateral_m <= a.lateral_m + 0.05 ||
@@ -605,12 +860,16 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
         }
         double s0, s1;
         Extent(frame, s, a.direction_2d, &s0, &s1);
-        between =
-            std::min(s1, std::min(a1, b1)) - std::max(s0, std::max(a0, b0)) >
-            0.0;
+        if (std::min(s1, std::min(a1, b1)) - std::max(s0, std::max(a0, b0)) <=
+            0.0) {
+          continue;
+        }
+        if (s.contrast < 0.0) first_end = std::min(first_end, s.lateral_m);
+        if (s.contrast > 0.0) last_start = std::max(last_start, s.lateral_m);
       }
-      if (between) continue;
+      if (first_end < last_start) continue;
       BandCandidate c;
+      c.edge_between = first_end < 1e30 || last_start > -1e30;
       c.lo = i;
       c.hi = j;
       c.begin = std::max(a0, b0);
@@ -631,6 +890,30 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     if (side_used[c.lo] || side_used[c.hi]) continue;
     side_used[c.lo] = side_used[c.hi] = 1;
     pairs.push_back(c);
+  }
+  // A band with an edge along it (a shadow boundary, or a lane line and its
+  // kerb lit between two shadows) is kept only beside other bands of a
+  // crossing.
+  {
+    std::vector<BandCandidate> kept;
+    for (const BandCandidate& c : pairs) {
+      int neighbours = 0;
+      const LongSide& a = sides[c.lo];
+      const double centre = 0.5 * (a.lateral_m + sides[c.hi].lateral_m);
+      for (const BandCandidate& o : pairs) {
+        const LongSide& b = sides[o.lo];
+        if (o.edge_between || b.direction_set != a.direction_set) continue;
+        const double other = 0.5 * (b.lateral_m + sides[o.hi].lateral_m);
+        if (&o != &c &&
+            std::abs(other - centre) <=
+                options.max_crossing_gap_m + 2.0 * zebra.band_width_m &&
+            std::min(c.end, o.end) - std::max(c.begin, o.begin) > 0.0) {
+          ++neighbours;
+        }
+      }
+      if (!c.edge_between || neighbours >= 2) kept.push_back(c);
+    }
+    pairs.swap(kept);
   }
   if (debug != nullptr) {
     for (const BandCandidate& c : pairs) {
@@ -675,11 +958,19 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     }
   }
 
-  // 3. Approximate transversal sides of each crossing: regression on the
-  // extremities of its longer long sides.
   const int crossings =
       m == 0 ? 0
              : *std::max_element(crossing_of.begin(), crossing_of.end()) + 1;
+  // 2b. Bands of which one long side is hidden (a parked vehicle) or merged
+  // with other paint (a lane line across the band's end).
+  if (options.complete_crossings) {
+    CompleteCrossings(frame, zebra, options, crossings, side_used, &sides,
+                      &pairs, &crossing_of);
+  }
+  const int m_all = static_cast<int>(pairs.size());
+
+  // 3. Approximate transversal sides of each crossing: regression on the
+  // extremities of its longer long sides (seen bands only).
   for (int i = 0; i < m; ++i) {
     VLOG(2) << "band " << i << ": sides " << pairs[i].lo << " " << pairs[i].hi
             << " set " << sides[pairs[i].lo].direction_set << " lateral "
@@ -720,9 +1011,11 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
             << across.transpose();
   }
 
-  // 4. Each band: plane, transversal sides, vertices.
-  std::vector<Band> bands;
-  for (int i = 0; i < m; ++i) {
+  // 4. Each band: plane, transversal sides, vertices. `known[e]`: the
+  // transversal side of end e is not searched but taken from that line of
+  // the plane frame (a hidden end, see below).
+  auto model_band = [&](int i, const KnownEnd known[2],
+                        Band* out) -> BandOutcome {
     const LongSide& lo = sides[pairs[i].lo];
     const LongSide& hi = sides[pairs[i].hi];
     const Eigen::Vector2d along = lo.direction_2d;
@@ -736,7 +1029,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     BandPlaneFit plane_fit;
     if (!FitBandPlane(support, lo.direction_body, frame.normal,
                       options.min_sigma_m, &plane_fit)) {
-      continue;
+      return BandOutcome::kRejected;
     }
     const RoadPlane& plane = plane_fit.plane;
     VLOG(2) << "band " << i << ": plane normal "
@@ -744,8 +1037,13 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
             << " n " << plane_fit.count << " side height rms "
             << lo.height_rms_m << " " << hi.height_rms_m << " lateral rms "
             << lo.lateral_rms_m << " " << hi.lateral_rms_m;
-    const double lateral_lo = lo.lateral_m + options.side_margin_m;
-    const double lateral_hi = hi.lateral_m - options.side_margin_m;
+    double lateral_lo = lo.lateral_m + options.side_margin_m;
+    double lateral_hi = hi.lateral_m - options.side_margin_m;
+    // A completed band's transversal sides are searched on its seen half:
+    // what hides the other side (a vehicle) must not vote.
+    const double seen_share = 0.55 * (hi.lateral_m - lo.lateral_m);
+    if (pairs[i].inferred == 1) lateral_hi = lo.lateral_m + seen_share;
+    if (pairs[i].inferred == 0) lateral_lo = hi.lateral_m - seen_share;
     const int crossing = crossing_of[i];
     // Search areas (3D corners on the band plane), begin then end.
     std::array<std::array<Eigen::Vector3d, 4>, 2> areas_3d;
@@ -773,6 +1071,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     double contrast = 0.0;
     int views = 0;
     bool failed = false;
+    bool transversal_failed = false;
     for (int side = 0; side < 2 && !failed; ++side) {
       // The band's approximate corners must be seen (the band is fully
       // visible); its search areas may run out of the image.
@@ -820,6 +1119,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       }
       std::vector<ImageLine> candidates_e[2];
       for (int e = 0; e < 2; ++e) {
+        if (known[e].line != nullptr) continue;
         candidates_e[e] = HoughTransversalCandidates(
             edges[side], areas[e], e == 0 ? expected_normal : -expected_normal,
             options);
@@ -834,18 +1134,64 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
           }
         }
       }
-      int t = -1, l = -1;
-      if (!ChooseTransversalPair(candidates_e[0], candidates_e[1],
-                                 band_direction, options, &t, &l)) {
-        failed = true;
-        VLOG(2) << "band " << i << " side " << side << ": no transversal pair";
-        break;
+      ImageLine transversal_lines[2];
+      if (known[0].line == nullptr && known[1].line == nullptr) {
+        int t = -1, l = -1;
+        if (!ChooseTransversalPair(candidates_e[0], candidates_e[1],
+                                   band_direction, options, &t, &l)) {
+          failed = transversal_failed = true;
+          VLOG(2) << "band " << i << " side " << side
+                  << ": no transversal pair";
+          break;
+        }
+        transversal_lines[0] = candidates_e[0][t];
+        transversal_lines[1] = candidates_e[1][l];
+      } else {
+        for (int e = 0; e < 2 && !failed; ++e) {
+          if (known[e].line != nullptr) {
+            // The known line through the band's long sides, in this image.
+            Eigen::Vector2d a, b;
+            failed = !rectification.ProjectToRectified(
+                         side,
+                         OnBandPlane(frame, plane,
+                                     AtLateral(*known[e].line, along, across,
+                                               lo.lateral_m, 0.0)),
+                         &a) ||
+                     !rectification.ProjectToRectified(
+                         side,
+                         OnBandPlane(frame, plane,
+                                     AtLateral(*known[e].line, along, across,
+                                               hi.lateral_m, 0.0)),
+                         &b);
+            if (!failed) transversal_lines[e] = LineThrough(a, b);
+            continue;
+          }
+          // The seen end: the strongest candidate of the right polarity.
+          const double sign = e == 0 ? 1.0 : -1.0;
+          const ImageLine* chosen = nullptr;
+          for (const ImageLine& line : candidates_e[e]) {
+            if (sign * line.gamma.dot(band_direction) > 0.0) {
+              chosen = &line;
+              break;
+            }
+          }
+          if (chosen == nullptr) {
+            failed = transversal_failed = true;
+          } else {
+            transversal_lines[e] = *chosen;
+          }
+        }
+        if (failed) {
+          VLOG(2) << "band " << i << " side " << side
+                  << ": no transversal side at the seen end";
+          break;
+        }
       }
-      ImageLine transversal_lines[2] = {candidates_e[0][t], candidates_e[1][l]};
       for (int e = 0; e < 2; ++e) {
+        if (known[e].line != nullptr) continue;
         if (!RefineImageLine(edges[side], areas[e], options,
                              &transversal_lines[e])) {
-          failed = true;
+          failed = transversal_failed = true;
           VLOG(2) << "band " << i << " side " << side << ": refinement failed";
           break;
         }
@@ -890,10 +1236,37 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
         }
       }
       if (failed) break;
+      // A seen transversal edge stops at the long sides: a shadow boundary
+      // across a lane line runs on over the road.
+      for (int e = 0; e < 2 && !failed; ++e) {
+        if (known[e].line != nullptr) continue;
+        Eigen::Vector2d ends[2];
+        if (!Intersect(long_lines[0], transversal_lines[e], &ends[0]) ||
+            !Intersect(long_lines[1], transversal_lines[e], &ends[1])) {
+          failed = true;
+          break;
+        }
+        // Beyond a hidden long side, what hides it may have edges.
+        const bool check[2] = {pairs[i].inferred != 0,
+                               pairs[i].inferred != 1};
+        const double run_on =
+            TransversalRunOn(edges[side], transversal_lines[e], ends, check);
+        VLOG(2) << "band " << i << " side " << side << " end " << e
+                << ": run-on " << run_on;
+        failed = run_on > options.max_transversal_run_on;
+      }
+      if (failed) {
+        VLOG(2) << "band " << i << " side " << side
+                << ": a transversal edge runs on beyond the band";
+        break;
+      }
       for (int v = 0; v < 4; ++v) vertex_sum[v] += vertex_side[side][v];
       ++views;
     }
-    if (failed || views != 2) continue;
+    if (failed || views != 2) {
+      return transversal_failed ? BandOutcome::kNoTransversal
+                                : BandOutcome::kRejected;
+    }
 
     Band band;
     band.plane = plane;
@@ -912,11 +1285,11 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                 band.vertices_body[2] + band.vertices_body[3]);
     if ((band_middle - rectification.left_centre_body()).norm() >
         options.max_band_range_m) {
-      continue;
+      return BandOutcome::kRejected;
     }
     if (disagreement > options.max_stereo_disagreement_m) {
       VLOG(2) << "band " << i << ": stereo disagreement " << disagreement;
-      continue;
+      return BandOutcome::kRejected;
     }
     const Eigen::Vector3d& v0 = band.vertices_body[0];
     const Eigen::Vector3d& v1 = band.vertices_body[1];
@@ -928,7 +1301,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     if (band.length_m < zebra.min_band_length_m - 0.5 ||
         band.length_m > zebra.max_band_length_m + 0.5) {
       VLOG(2) << "band " << i << ": length " << band.length_m;
-      continue;
+      return BandOutcome::kRejected;
     }
 
     // Covariance: along the band from the transversal line fits, across
@@ -950,10 +1323,16 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       // The two images' lines are independent estimates.
       const double sigma_px =
           0.5 * std::hypot(line_sigma_px[0][e], line_sigma_px[1][e]);
-      const double sigma_along = sigma_px * metres_per_px;
-      const double sigma_across = std::max(
-          options.min_sigma_m,
-          s.lateral_rms_m / std::sqrt(static_cast<double>(s.support.size())));
+      const double sigma_along = known[e].line != nullptr
+                                     ? known[e].sigma_m
+                                     : sigma_px * metres_per_px;
+      const bool inferred = pairs[i].inferred == (v == 0 || v == 3 ? 0 : 1);
+      const double sigma_across =
+          inferred
+              ? pairs[i].inferred_sigma_m
+              : std::max(options.min_sigma_m,
+                         s.lateral_rms_m /
+                             std::sqrt(static_cast<double>(s.support.size())));
       const double sigma_height =
           std::max(options.min_sigma_m, std::sqrt(plane_fit.HeightVariance(p)));
       const Eigen::Vector3d along_ray = ray / std::abs(plane_normal.dot(ray));
@@ -973,7 +1352,114 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
         std::exp(-0.5 * std::pow(plane_fit.rms_m / 0.02, 2));
     band.score = std::clamp(
         width_term * stereo_term * contrast_term * flat_term, 0.0, 1.0);
-    bands.push_back(band);
+    // A completed band's hidden side is an inference, not a measurement.
+    if (pairs[i].inferred >= 0) band.score *= options.inferred_score_factor;
+    band.inferred_side = pairs[i].inferred;
+    for (int e = 0; e < 2; ++e) {
+      if (known[e].line != nullptr) {
+        band.score *= options.inferred_score_factor;
+        band.inferred_end = e;
+      }
+    }
+    *out = band;
+    return BandOutcome::kBand;
+  };
+
+  std::vector<Band> bands;
+  std::vector<int> without_transversal;
+  const KnownEnd none[2];
+  for (int i = 0; i < m_all; ++i) {
+    Band band;
+    const BandOutcome outcome = model_band(i, none, &band);
+    if (outcome == BandOutcome::kBand) bands.push_back(band);
+    if (outcome == BandOutcome::kNoTransversal) {
+      without_transversal.push_back(i);
+    }
+  }
+  if (!options.infer_hidden_ends || without_transversal.empty()) return bands;
+
+  // 5. Hidden ends: a vehicle parked before a crossing hides the end of its
+  // outer bands. The transversal sides of a crossing are one line at each
+  // end; fitted on the vertices of its fully seen bands, that line gives
+  // the hidden end when it is reliable: enough bands, small residuals, a
+  // band next to them. The band's seen end must lie on the other line.
+  std::vector<std::array<PlaneLine, 2>> lines(crossings);
+  std::vector<std::array<double, 2>> line_sigma(crossings, {-1.0, -1.0});
+  std::vector<std::array<double, 2>> line_rms(crossings, {-1.0, -1.0});
+  std::vector<std::array<double, 2>> lateral_range(crossings, {1e30, -1e30});
+  for (int c = 0; c < crossings; ++c) {
+    for (int e = 0; e < 2; ++e) {
+      std::vector<Eigen::Vector2d> points;
+      Eigen::Vector2d across = Eigen::Vector2d::UnitY();
+      for (const Band& band : bands) {
+        if (band.crossing != c || band.inferred_side >= 0) continue;
+        const Eigen::Vector2d a = frame.To2d(band.vertices_body[e == 0 ? 0 : 3]);
+        const Eigen::Vector2d b = frame.To2d(band.vertices_body[e == 0 ? 1 : 2]);
+        points.push_back(a);
+        points.push_back(b);
+        across = sides[band.sides[0]].Normal2d();
+        lateral_range[c][0] = std::min(lateral_range[c][0], a.dot(across));
+        lateral_range[c][1] = std::max(lateral_range[c][1], b.dot(across));
+      }
+      if (static_cast<int>(points.size()) < 2 * options.completion_min_bands) {
+        continue;
+      }
+      lines[c][e] = FitPlaneLine(points, across);
+      const Eigen::Vector2d normal(-lines[c][e].direction.y(),
+                                   lines[c][e].direction.x());
+      double sum_squares = 0.0;
+      for (const Eigen::Vector2d& p : points) {
+        sum_squares += std::pow((p - lines[c][e].point).dot(normal), 2);
+      }
+      const double rms =
+          std::sqrt(sum_squares / static_cast<double>(points.size() - 2));
+      VLOG(2) << "crossing " << c << " end " << e << ": line through "
+              << points.size() / 2 << " bands, rms " << rms;
+      line_rms[c][e] = rms;
+      if (rms <= options.hidden_end_max_rms_m) {
+        line_sigma[c][e] = std::max(options.completion_min_sigma_m, 2.0 * rms);
+      }
+    }
+  }
+  for (int i : without_transversal) {
+    const int c = crossing_of[i];
+    if (line_rms[c][0] < 0.0 || line_rms[c][1] < 0.0) continue;
+    // Next to the seen bands: at most one band period out of them.
+    const LongSide& lo = sides[pairs[i].lo];
+    const LongSide& hi = sides[pairs[i].hi];
+    const Eigen::Vector2d across = lo.Normal2d();
+    const double reach = 2.5 * zebra.band_width_m;
+    const double lateral_lo = frame.To2d(lo.point_body).dot(across);
+    const double lateral_hi = frame.To2d(hi.point_body).dot(across);
+    if (lateral_lo < lateral_range[c][0] - reach ||
+        lateral_hi > lateral_range[c][1] + reach) {
+      continue;
+    }
+    for (int e = 0; e < 2; ++e) {
+      if (line_sigma[c][e] < 0.0) continue;  // not reliable
+      KnownEnd known[2];
+      known[e].line = &lines[c][e];
+      known[e].sigma_m = line_sigma[c][e];
+      Band band;
+      if (model_band(i, known, &band) != BandOutcome::kBand) continue;
+      // The seen end on the crossing's line of that end.
+      const PlaneLine& other = lines[c][1 - e];
+      const Eigen::Vector2d normal(-other.direction.y(), other.direction.x());
+      double worst = 0.0;
+      for (int v : e == 0 ? std::array<int, 2>{2, 3} : std::array<int, 2>{0, 1}) {
+        worst = std::max(worst, std::abs((frame.To2d(band.vertices_body[v]) -
+                                          other.point)
+                                             .dot(normal)));
+      }
+      VLOG(2) << "band " << i << ": hidden end " << e << ", seen end "
+              << worst << " m off the crossing's line";
+      if (worst > std::max(options.hidden_end_max_offset_m,
+                           3.0 * line_rms[c][1 - e])) {
+        continue;
+      }
+      bands.push_back(band);
+      break;
+    }
   }
   return bands;
 }

@@ -55,6 +55,11 @@ struct BandOptions {
   // within this distance, at least this many along it.
   double refine_distance_px = 6.0;
   int min_transversal_points = 8;
+  // The gradient across a seen transversal side beyond the long sides must
+  // stay below this share of the one along the band's end: a shadow
+  // boundary across a lane line runs on over the road, a painted end does
+  // not.
+  double max_transversal_run_on = 0.6;
   // The left and right images give two estimates of each vertex; a band
   // whose estimates differ by more is dropped.
   double max_stereo_disagreement_m = 0.05;
@@ -70,6 +75,30 @@ struct BandOptions {
   double min_line_sigma_px = 0.1;
   // Floor of the long side and band plane standard deviations.
   double min_sigma_m = 0.002;
+  // Crossing completion: a long side that no band took, where the regular
+  // pattern of a crossing of at least completion_min_bands bands expects
+  // the side of a missing band (within completion_tolerance_m), makes a
+  // band with its other side one median band width away: the other side is
+  // hidden by a vehicle or merged with a lane line. That inferred side's
+  // standard deviation is the spread of the crossing's widths, at least
+  // completion_min_sigma_m, and the band's score is multiplied by
+  // inferred_score_factor.
+  bool complete_crossings = true;
+  int completion_min_bands = 3;
+  double completion_tolerance_m = 0.04;
+  double completion_min_sigma_m = 0.01;
+  double inferred_score_factor = 0.5;
+  // Hidden band ends: when no transversal side is found at one end of a
+  // band, the line through that end's vertices of the crossing's fully
+  // seen bands (at least completion_min_bands, residual rms at most
+  // hidden_end_max_rms_m) gives it; the band's seen end must then lie
+  // within hidden_end_max_offset_m (or 3 rms) of the crossing's other line.
+  // The
+  // inferred end's standard deviation along the band is twice that rms, at
+  // least completion_min_sigma_m.
+  bool infer_hidden_ends = true;
+  double hidden_end_max_rms_m = 0.01;
+  double hidden_end_max_offset_m = 0.03;
 
   std::string Check() const;
 };
@@ -128,6 +157,12 @@ struct Band {
   double width_m = 0.0;
   double length_m = 0.0;
   double stereo_disagreement_m = 0.0;
+  // 0 or 1: that long side (sides[k]) was inferred from the crossing, not
+  // seen (BandOptions::complete_crossings); -1: both seen.
+  int inferred_side = -1;
+  // 0 (begin) or 1 (end): that transversal side was inferred from the
+  // crossing (BandOptions::infer_hidden_ends); -1: both seen.
+  int inferred_end = -1;
 };
 
 // What band modelling tried, for debug images (left rectified pixels).

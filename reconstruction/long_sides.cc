@@ -539,6 +539,10 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
         side.contrast = contrast / count;
         side.lateral_m = frame.To2d(mean).dot(normal);
         side.support = std::move(g.support);
+        VLOG(2) << "long side " << result.sides.size() << ": set " << set
+                << " lateral " << side.lateral_m << " extent " << side.t_begin
+                << " " << side.t_end << " contrast " << side.contrast
+                << " points " << side.support.size();
         result.sides.push_back(std::move(side));
       }
     }

@@ -451,6 +451,7 @@ ExposureResult ProcessExposure(
                        "_pair" + std::to_string(p)))
                          .string();
     }
+    VLOG(2) << "exposure " << exposure.exposure_id << " pair " << p;
     result.pairs[p] = pairs[p]->Reconstruct(
         images[rig.stereo_pairs[p][0]], images[rig.stereo_pairs[p][1]], prior,
         slab_half_thickness_m, tolerance_angle_rad, seed, stop_after_road_plane,

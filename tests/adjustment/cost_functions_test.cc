@@ -4,7 +4,9 @@
 #include <ceres/numeric_diff_cost_function.h>
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
+#include <vector>
 
 #include "adjustment/trajectory_correction.h"
 
@@ -147,6 +149,55 @@ TEST(LinearPrior, SecondDifferenceJacobiansPassGradientChecker) {
   double r[6];
   prior.Evaluate(parameters, r, nullptr);
   EXPECT_DOUBLE_EQ(r[0], 3.0 * (1 - 1 + 3));
+}
+
+TEST(LinearPrior, EverySizeAndCentrePassesGradientChecker) {
+  ceres::NumericDiffOptions numeric;
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::GradientChecker::ProbeResults results;
+  Eigen::Matrix<double, 6, 6> S6 = Eigen::Matrix<double, 6, 6>::Identity();
+  S6(0, 1) = 0.5;
+  S6(5, 5) = 20.0;
+  Eigen::Matrix<double, 6, 1> b;
+  b << 0.1, -0.2, 0.3, 1.0, 2.0, -3.0;
+  Knot a = {1, 2, 3, 4, 5, 6}, c = {0.5, 0, 1, 2, 2, 2};
+  std::unique_ptr<ceres::CostFunction> absolute(
+      LinearPrior<1, 6>::Create(S6, {1.0}, b));
+  const double* one[1] = {a.data()};
+  ceres::GradientChecker check1(absolute.get(), no_manifolds, numeric);
+  EXPECT_TRUE(check1.Probe(one, 1e-8, &results)) << results.error_log;
+  double r[6];
+  absolute->Evaluate(one, r, nullptr);
+  EXPECT_NEAR(r[5], 20.0 * (6.0 + 3.0), 1e-12);  // S (x - b)
+  EXPECT_NEAR(r[0], (1.0 - 0.1) + 0.5 * (2.0 + 0.2), 1e-12);
+
+  std::unique_ptr<ceres::CostFunction> rate(
+      LinearPrior<2, 6>::Create(S6, {-1.0, 1.0}));
+  const double* two[2] = {a.data(), c.data()};
+  ceres::GradientChecker check2(rate.get(), no_manifolds, numeric);
+  EXPECT_TRUE(check2.Probe(two, 1e-8, &results)) << results.error_log;
+
+  const Eigen::Matrix3d S3 = Eigen::Vector3d(10.0, 10.0, 5.0).asDiagonal();
+  std::unique_ptr<ceres::CostFunction> offset(
+      LinearPrior<1, 3>::Create(S3, {1.0}));
+  const double x3[3] = {0.1, -0.05, 0.2};
+  const double* three[1] = {x3};
+  ceres::GradientChecker check3(offset.get(), no_manifolds, numeric);
+  EXPECT_TRUE(check3.Probe(three, 1e-8, &results)) << results.error_log;
+}
+
+TEST(PointPriorError, JacobiansPassGradientChecker) {
+  const Eigen::Vector3d prior(10.0, 20.0, 30.0);
+  Eigen::Matrix3d S = Eigen::Vector3d(10.0, 10.0, 5.0).asDiagonal();
+  S(0, 2) = 1.5;
+  std::unique_ptr<ceres::CostFunction> cost(PointPriorError::Create(prior, S));
+  const Eigen::Vector3d point(10.1, 19.9, 30.2), offset(0.05, 0.0, 0.1);
+  const double* parameters[2] = {point.data(), offset.data()};
+  ceres::NumericDiffOptions numeric;
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::GradientChecker checker(cost.get(), no_manifolds, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(parameters, 1e-8, &results)) << results.error_log;
 }
 
 TEST(PointPriorError, WhitensTheDifferenceWithTheOffset) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <set>
 
@@ -139,6 +140,67 @@ TEST(TrajectoryAdjuster, WrongControlPointsAreFlaggedAndRemoved) {
   EXPECT_FALSE(result.summary.warnings.empty());
   const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
   EXPECT_LT(after.rmse_horizontal_m, 0.08);
+}
+
+// The demo preset's failure: the vertical drift is a few centimetres and
+// the database's crossings are 5-15 cm off. Followed blindly, the control
+// moves the trajectory vertically by the database's error; the GNSS/INS
+// sigma estimated from the control (variance components) must see that
+// the vertical discrepancies are the database's and leave the vertical
+// alone, while the horizontal drift is corrected.
+TEST(TrajectoryAdjuster, DatabaseErrorLargerThanTheDriftDoesNotMakeItWorse) {
+  SyntheticSurveyOptions options;
+  options.num_exposures = 200;
+  options.drift_horizontal_m = 0.5;
+  options.drift_vertical_m = 0.02;
+  // Per axis, the adjustment's crossing_offset_sigma_m (the contract's "5
+  // to 15 cm off").
+  options.database_offset_m = 0.07;
+  const Fixture f = MakeFixture(options);
+  AdjustmentOptions adjustment;
+  adjustment.check_crossing_share = 0.0;
+  const AdjustmentResult result = AdjustTrajectory(adjustment, f.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  const PoseErrors before = ScorePoses(f.survey, InputCameraPoses(f.survey));
+  const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
+  EXPECT_LT(after.rmse_horizontal_m, 0.5 * before.rmse_horizontal_m);
+  EXPECT_LE(after.rmse_vertical_m, before.rmse_vertical_m + 0.005);
+  // The prior it settled on is of the drift's size, not the configured 1 m.
+  EXPECT_GT(result.summary.gnss_sigma_horizontal_m, 0.1);
+  EXPECT_LT(result.summary.gnss_sigma_vertical_m, 0.06);
+
+  // Believing the GNSS/INS no better than 1 m follows the database instead:
+  // the test above can fail.
+  adjustment.estimate_gnss_sigma = false;
+  const AdjustmentResult blind = AdjustTrajectory(adjustment, f.Input());
+  ASSERT_TRUE(blind.summary.IsUsable()) << blind.summary.message;
+  const PoseErrors followed = ScorePoses(f.survey, blind.camera_poses);
+  EXPECT_GT(followed.rmse_vertical_m, after.rmse_vertical_m + 0.005);
+}
+
+// Check crossings: held out of a first adjustment (their residuals), then
+// control in the final one, which is then as good as with every crossing.
+TEST(TrajectoryAdjuster, CheckCrossingsAreControlInTheFinalAdjustment) {
+  const Fixture f = MakeFixture(KilometreOptions());
+  AdjustmentOptions options;
+  const AdjustmentResult final_result = AdjustTrajectory(options, f.Input());
+  options.check_points_in_final = false;
+  const AdjustmentResult held_out = AdjustTrajectory(options, f.Input());
+  options.check_crossing_share = 0.0;
+  const AdjustmentResult all = AdjustTrajectory(options, f.Input());
+  ASSERT_TRUE(final_result.summary.IsUsable());
+  ASSERT_TRUE(held_out.summary.IsUsable());
+  ASSERT_TRUE(all.summary.IsUsable());
+  EXPECT_TRUE(final_result.summary.check_points_in_final);
+  EXPECT_FALSE(held_out.summary.check_points_in_final);
+  // Same held-out residuals in both.
+  EXPECT_NEAR(final_result.summary.check_rmse_horizontal_m,
+              held_out.summary.check_rmse_horizontal_m, 1e-6);
+  EXPECT_GT(final_result.summary.num_check_points, 0);
+  const double e_final = ScorePoses(f.survey, final_result.camera_poses)
+                             .rmse_horizontal_m;
+  const double e_all = ScorePoses(f.survey, all.camera_poses).rmse_horizontal_m;
+  EXPECT_NEAR(e_final, e_all, 0.002);
 }
 
 TEST(TrajectoryAdjuster, SelfCalibrationRecoversALeverArmError) {
