@@ -275,9 +275,14 @@ struct BandCandidate {
 struct KnownEnd {
   const PlaneLine* line = nullptr;
   double sigma_m = 0.0;
+  // For the seen end of such a band: the crossing's line there, to choose
+  // among the candidates (what hides the other end may have edges too).
+  const PlaneLine* expected = nullptr;
 };
 
-enum class BandOutcome { kBand, kRejected, kNoTransversal };
+// kNoTransversal: no transversal side at an end; kDisagreement: the two
+// images disagree (a vehicle hides an end in one of them).
+enum class BandOutcome { kBand, kRejected, kNoTransversal, kDisagreement };
 
 double MedianOf(std::vector<double> values) {
   const size_t mid = values.size() / 2;
@@ -298,47 +303,6 @@ void Extent(const PlaneFrame& frame, const LongSide& side,
   const double b = frame.To2d(side.End()).dot(along);
   *low = std::min(a, b);
   *high = std::max(a, b);
-}
-
-
-// How far a transversal edge runs on beyond the band: the mean gradient
-// across `line` (with its polarity) beyond the band's long sides, from 10 %
-// to 50 % of the band width outside `ends` (the image vertices; `check`
-// says which side to look beyond), over the mean along the middle of the
-// band's end. About 0 for a band's painted end, much more for a shadow
-// boundary crossing the road. 0 when nothing beyond can be sampled.
-double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
-                        const Eigen::Vector2d ends[2], const bool check[2]) {
-  if (!(line.gamma.norm() > 0.0)) return 0.0;
-  const Eigen::Vector2d polarity = line.gamma.normalized();
-  const Eigen::Vector2d span = ends[1] - ends[0];
-  const double width = span.norm();
-  if (!(width > 2.0)) return 0.0;
-  const Eigen::Vector2d unit = span / width;
-  auto mean_between = [&](const Eigen::Vector2d& from, double t0, double t1,
-                          const Eigen::Vector2d& direction) {
-    double sum = 0.0;
-    int count = 0;
-    for (double t = t0; t <= t1; t += 1.0) {
-      const Eigen::Vector2d p = from + t * direction;
-      if (!edges.IsUsable(p.x(), p.y())) continue;
-      const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
-      sum += polarity.x() * g[0] + polarity.y() * g[1];
-      ++count;
-    }
-    return count >= 3 ? sum / count : std::nan("");
-  };
-  const double inside =
-      mean_between(ends[0], 0.2 * width, 0.8 * width, unit);
-  if (!(inside > 0.0)) return 0.0;
-  double run_on = 0.0;
-  for (int k = 0; k < 2; ++k) {
-    if (!check[k]) continue;
-    const double outside = mean_between(ends[k], 0.1 * width, 0.5 * width,
-                                        k == 0 ? Eigen::Vector2d(-unit) : unit);
-    if (std::isfinite(outside)) run_on = std::max(run_on, outside / inside);
-  }
-  return run_on;
 }
 
 // Completes the crossings: a long side that no band took, lying where the
@@ -406,7 +370,8 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
     }
     bool irregular = false;
     for (double d : regular) {
-      irregular = irregular || std::abs(d - period) > options.completion_tolerance_m;
+      irregular =
+          irregular || std::abs(d - period) > options.completion_tolerance_m;
     }
     if (irregular) continue;
     const double begin = MedianOf(begins);
@@ -417,8 +382,8 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
     for (int k = 0; k < n; ++k) {
       const LongSide& s = (*sides)[k];
       if (side_used[k] || s.direction_set != set) continue;
-      if (std::acos(std::min(1.0, std::abs(s.direction_body.dot(
-                                      direction_body)))) >
+      if (std::acos(
+              std::min(1.0, std::abs(s.direction_body.dot(direction_body)))) >
           options.max_side_angle_rad) {
         continue;
       }
@@ -440,14 +405,13 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
       const double residual = std::abs(position - slot) * period;
       if (residual > options.completion_tolerance_m) continue;
       // One slot beyond the outer bands at most; not an occupied slot.
-      const int last =
-          static_cast<int>(std::lround((centres.back() - centres.front()) /
-                                       period));
+      const int last = static_cast<int>(
+          std::lround((centres.back() - centres.front()) / period));
       if (slot < -1 || slot > last + 1) continue;
       bool occupied = false;
       for (double x : centres) {
-        occupied = occupied ||
-                   std::abs(x - (centres.front() + slot * period)) < 0.5 * period;
+        occupied = occupied || std::abs(x - (centres.front() + slot * period)) <
+                                   0.5 * period;
       }
       if (occupied) continue;
       auto it = best.find(slot);
@@ -491,16 +455,15 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
       candidate.inferred = seen_is_lo ? 1 : 0;
       candidate.inferred_sigma_m = std::hypot(
           width_sigma,
-          seen.lateral_rms_m /
-              std::sqrt(static_cast<double>(std::max<size_t>(
-                  1, seen.support.size()))));
+          seen.lateral_rms_m / std::sqrt(static_cast<double>(
+                                   std::max<size_t>(1, seen.support.size()))));
       double s0, s1;
       Extent(frame, seen, along, &s0, &s1);
       candidate.begin = s0;
       candidate.end = s1;
-      VLOG(2) << "crossing " << c << ": side " << k << " at "
-              << seen.lateral_m << " completes slot " << slot
-              << " (width " << width << ", period " << period << ")";
+      VLOG(2) << "crossing " << c << ": side " << k << " at " << seen.lateral_m
+              << " completes slot " << slot << " (width " << width
+              << ", period " << period << ")";
       pairs->push_back(candidate);
       crossing_of->push_back(c);
     }
@@ -804,6 +767,39 @@ bool RefineImageLine(const EdgeMap& edges, const Area& area,
   current.gamma = Gamma(edges, area, current);
   *line = current;
   return true;
+}
+
+double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
+                        const Eigen::Vector2d ends[2], const bool check[2]) {
+  if (!(line.gamma.norm() > 0.0)) return 0.0;
+  const Eigen::Vector2d polarity = line.gamma.normalized();
+  const Eigen::Vector2d span = ends[1] - ends[0];
+  const double width = span.norm();
+  if (!(width > 2.0)) return 0.0;
+  const Eigen::Vector2d unit = span / width;
+  auto mean_between = [&](const Eigen::Vector2d& from, double t0, double t1,
+                          const Eigen::Vector2d& direction) {
+    double sum = 0.0;
+    int count = 0;
+    for (double t = t0; t <= t1; t += 1.0) {
+      const Eigen::Vector2d p = from + t * direction;
+      if (!edges.IsUsable(p.x(), p.y())) continue;
+      const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
+      sum += polarity.x() * g[0] + polarity.y() * g[1];
+      ++count;
+    }
+    return count >= 3 ? sum / count : std::nan("");
+  };
+  const double inside = mean_between(ends[0], 0.2 * width, 0.8 * width, unit);
+  if (!(inside > 0.0)) return 0.0;
+  double run_on = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    if (!check[k]) continue;
+    const double outside = mean_between(ends[k], 0.1 * width, 0.5 * width,
+                                        k == 0 ? Eigen::Vector2d(-unit) : unit);
+    if (std::isfinite(outside)) run_on = std::max(run_on, outside / inside);
+  }
+  return run_on;
 }
 
 std::vector<Band> ModelBands(const LongSideDetection& detection,
@@ -1166,14 +1162,30 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
             if (!failed) transversal_lines[e] = LineThrough(a, b);
             continue;
           }
-          // The seen end: the strongest candidate of the right polarity.
+          // The seen end: the candidate of the right polarity nearest to
+          // the crossing's line there (the strongest without one).
           const double sign = e == 0 ? 1.0 : -1.0;
+          Eigen::Vector2d expected_xy = Eigen::Vector2d::Zero();
+          const bool has_expected =
+              known[e].expected != nullptr &&
+              rectification.ProjectToRectified(
+                  side,
+                  OnBandPlane(
+                      frame, plane,
+                      AtLateral(*known[e].expected, along, across,
+                                0.5 * (lo.lateral_m + hi.lateral_m), 0.0)),
+                  &expected_xy);
           const ImageLine* chosen = nullptr;
+          double best_distance = 1e30;
           for (const ImageLine& line : candidates_e[e]) {
-            if (sign * line.gamma.dot(band_direction) > 0.0) {
+            if (sign * line.gamma.dot(band_direction) <= 0.0) continue;
+            const double distance =
+                has_expected ? std::abs(line.Distance(expected_xy)) : 0.0;
+            if (distance < best_distance) {
+              best_distance = distance;
               chosen = &line;
-              break;
             }
+            if (!has_expected) break;
           }
           if (chosen == nullptr) {
             failed = transversal_failed = true;
@@ -1247,8 +1259,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
           break;
         }
         // Beyond a hidden long side, what hides it may have edges.
-        const bool check[2] = {pairs[i].inferred != 0,
-                               pairs[i].inferred != 1};
+        const bool check[2] = {pairs[i].inferred != 0, pairs[i].inferred != 1};
         const double run_on =
             TransversalRunOn(edges[side], transversal_lines[e], ends, check);
         VLOG(2) << "band " << i << " side " << side << " end " << e
@@ -1289,7 +1300,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     }
     if (disagreement > options.max_stereo_disagreement_m) {
       VLOG(2) << "band " << i << ": stereo disagreement " << disagreement;
-      return BandOutcome::kRejected;
+      return BandOutcome::kDisagreement;
     }
     const Eigen::Vector3d& v0 = band.vertices_body[0];
     const Eigen::Vector3d& v1 = band.vertices_body[1];
@@ -1372,7 +1383,8 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     Band band;
     const BandOutcome outcome = model_band(i, none, &band);
     if (outcome == BandOutcome::kBand) bands.push_back(band);
-    if (outcome == BandOutcome::kNoTransversal) {
+    if (outcome == BandOutcome::kNoTransversal ||
+        outcome == BandOutcome::kDisagreement) {
       without_transversal.push_back(i);
     }
   }
@@ -1383,6 +1395,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   // end; fitted on the vertices of its fully seen bands, that line gives
   // the hidden end when it is reliable: enough bands, small residuals, a
   // band next to them. The band's seen end must lie on the other line.
+  // (An end hidden in one image only makes the two images disagree.)
   std::vector<std::array<PlaneLine, 2>> lines(crossings);
   std::vector<std::array<double, 2>> line_sigma(crossings, {-1.0, -1.0});
   std::vector<std::array<double, 2>> line_rms(crossings, {-1.0, -1.0});
@@ -1393,8 +1406,10 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       Eigen::Vector2d across = Eigen::Vector2d::UnitY();
       for (const Band& band : bands) {
         if (band.crossing != c || band.inferred_side >= 0) continue;
-        const Eigen::Vector2d a = frame.To2d(band.vertices_body[e == 0 ? 0 : 3]);
-        const Eigen::Vector2d b = frame.To2d(band.vertices_body[e == 0 ? 1 : 2]);
+        const Eigen::Vector2d a =
+            frame.To2d(band.vertices_body[e == 0 ? 0 : 3]);
+        const Eigen::Vector2d b =
+            frame.To2d(band.vertices_body[e == 0 ? 1 : 2]);
         points.push_back(a);
         points.push_back(b);
         across = sides[band.sides[0]].Normal2d();
@@ -1440,21 +1455,24 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       KnownEnd known[2];
       known[e].line = &lines[c][e];
       known[e].sigma_m = line_sigma[c][e];
+      known[1 - e].expected = &lines[c][1 - e];
       Band band;
       if (model_band(i, known, &band) != BandOutcome::kBand) continue;
       // The seen end on the crossing's line of that end.
       const PlaneLine& other = lines[c][1 - e];
       const Eigen::Vector2d normal(-other.direction.y(), other.direction.x());
       double worst = 0.0;
-      for (int v : e == 0 ? std::array<int, 2>{2, 3} : std::array<int, 2>{0, 1}) {
-        worst = std::max(worst, std::abs((frame.To2d(band.vertices_body[v]) -
-                                          other.point)
-                                             .dot(normal)));
+      for (int v :
+           e == 0 ? std::array<int, 2>{2, 3} : std::array<int, 2>{0, 1}) {
+        worst = std::max(
+            worst,
+            std::abs(
+                (frame.To2d(band.vertices_body[v]) - other.point).dot(normal)));
       }
-      VLOG(2) << "band " << i << ": hidden end " << e << ", seen end "
-              << worst << " m off the crossing's line";
-      if (worst > std::max(options.hidden_end_max_offset_m,
-                           3.0 * line_rms[c][1 - e])) {
+      VLOG(2) << "band " << i << ": hidden end " << e << ", seen end " << worst
+              << " m off the crossing's line";
+      if (worst >
+          std::max(options.hidden_end_max_offset_m, 3.0 * line_rms[c][1 - e])) {
         continue;
       }
       bands.push_back(band);

@@ -147,6 +147,16 @@ bool RefineImageLine(const EdgeMap& edges,
                      const std::array<Eigen::Vector2d, 4>& area,
                      const BandOptions& options, ImageLine* line);
 
+// How far a transversal side runs on beyond its band: the mean gradient
+// across `line` (with the polarity of its gamma) beyond the band's long
+// sides, from 10 % to 50 % of the band width outside `ends` (the band's
+// image vertices on that line; `check[k]` says whether to look beyond
+// ends[k]), over the mean along the middle of the band's end. About 0 for
+// a painted end, about 1 for a shadow boundary crossing the road. 0 when
+// nothing can be sampled.
+double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
+                        const Eigen::Vector2d ends[2], const bool check[2]);
+
 struct Band {
   std::array<Eigen::Vector3d, 4> vertices_body;
   std::array<Eigen::Matrix3d, 4> covariances_body;

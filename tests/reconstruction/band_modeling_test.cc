@@ -112,6 +112,54 @@ TEST(HoughTransversal, PairChoiceTakesTheMostOppositeStrongPair) {
   EXPECT_EQ(l, 0);
 }
 
+TEST(HoughTransversal, PaintedEndStopsAtTheBandAShadowBoundaryRunsOn) {
+  // A painted end: nothing across the line beyond the long sides.
+  const cv::Mat band = RenderBand(0.7);
+  const EdgeMap band_edges =
+      DetectSubpixelEdges(band, cv::Mat(), EdgeOptions());
+  BandOptions options;
+  std::vector<ImageLine> begin = HoughTransversalCandidates(
+      band_edges, Area(60.0), Eigen::Vector2d(0, 1), options);
+  ASSERT_FALSE(begin.empty());
+  ASSERT_TRUE(RefineImageLine(band_edges, Area(60.0), options, &begin[0]));
+  // The band's corners on that line (long sides x = 70 and x = 103).
+  auto on_line = [](const ImageLine& line, double x) {
+    return Eigen::Vector2d(x,
+                           (line.rho - line.normal.x() * x) / line.normal.y());
+  };
+  const Eigen::Vector2d band_ends[2] = {on_line(begin[0], 70.0),
+                                        on_line(begin[0], 103.0)};
+  const bool both[2] = {true, true};
+  EXPECT_LT(TransversalRunOn(band_edges, begin[0], band_ends, both), 0.1);
+
+  // A shadow boundary across bare road at y = 150: as strong beyond the
+  // "band" as inside it.
+  cv::Mat road(300, 170, CV_32F);
+  for (int y = 0; y < road.rows; ++y) {
+    road.row(y).setTo(y < 150 ? 90.0 : 45.0);
+  }
+  cv::GaussianBlur(road, road, cv::Size(0, 0), 0.7);
+  cv::Mat noise(road.size(), CV_32F);
+  cv::randn(noise, 0.0, 1.5);
+  road += noise;
+  const EdgeMap road_edges =
+      DetectSubpixelEdges(road, cv::Mat(), EdgeOptions());
+  // The image darkens along +y: a begin side would brighten.
+  std::vector<ImageLine> shadow = HoughTransversalCandidates(
+      road_edges, Area(150.0), Eigen::Vector2d(0, -1), options);
+  ASSERT_FALSE(shadow.empty());
+  ASSERT_TRUE(RefineImageLine(road_edges, Area(150.0), options, &shadow[0]));
+  const Eigen::Vector2d shadow_ends[2] = {on_line(shadow[0], 70.0),
+                                          on_line(shadow[0], 103.0)};
+  const double run_on =
+      TransversalRunOn(road_edges, shadow[0], shadow_ends, both);
+  EXPECT_GT(run_on, 0.8);
+  EXPECT_GT(run_on, options.max_transversal_run_on);
+  // Beyond neither side: nothing to compare, no run-on.
+  const bool neither[2] = {false, false};
+  EXPECT_EQ(TransversalRunOn(road_edges, shadow[0], shadow_ends, neither), 0.0);
+}
+
 TEST(BandOptions, CheckNamesTheBadField) {
   BandOptions options;
   options.hough_score_fraction = 1.5;
