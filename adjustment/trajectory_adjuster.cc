@@ -396,8 +396,8 @@ class AdjustmentProblem {
     // prior_correlation_time_s: the prior's sigma holds once per correlation
     // time, not once per knot (which would pin the mean correction to
     // sigma / sqrt(knots)).
-    const double widen = std::sqrt(
-        std::max(1.0, options_.prior_correlation_time_s / dt));
+    const double widen =
+        std::sqrt(std::max(1.0, options_.prior_correlation_time_s / dt));
     Eigen::Matrix<double, 6, 6> S_att = Eigen::Matrix<double, 6, 6>::Zero();
     S_att.diagonal().head<3>().setConstant(
         1.0 / (options_.ins_attitude_sigma_deg * kDegToRad));
@@ -433,14 +433,15 @@ class AdjustmentProblem {
     for (int k = 0; k < n; ++k) {
       const Eigen::Matrix<double, 6, 1>& b =
           state_->knot_prior.empty() ? zero : state_->knot_prior[k];
-      problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S_att, {1.0}, b), nullptr,
-                                 knots[k].data());
-      blocks_.gnss.push_back(problem_->AddResidualBlock(
-          LinearPrior<1, 6>::Create(S_pos, {1.0}, b), gnss_loss_.get(), knots[k].data()));
+      problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S_att, {1.0}, b),
+                                 nullptr, knots[k].data());
+      blocks_.gnss.push_back(
+          problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S_pos, {1.0}, b),
+                                     gnss_loss_.get(), knots[k].data()));
       if (k + 1 < n) {
-        problem_->AddResidualBlock(LinearPrior<2, 6>::Create(S_rate, {-1.0, 1.0}),
-                                   nullptr, knots[k].data(),
-                                   knots[k + 1].data());
+        problem_->AddResidualBlock(
+            LinearPrior<2, 6>::Create(S_rate, {-1.0, 1.0}), nullptr,
+            knots[k].data(), knots[k + 1].data());
       }
       if (k + 2 < n) {
         problem_->AddResidualBlock(
@@ -594,6 +595,13 @@ void EvaluateControlPoints(const AdjustmentOptions& options, const Rig& rig,
   }
 }
 
+// 95% quantile of the chi-square distribution with k degrees of freedom
+// (Wilson-Hilferty; within 1% for k >= 1).
+double ChiSquare95(int k) {
+  const double a = 2.0 / (9.0 * k);
+  const double c = 1.0 - a + 1.6448536 * std::sqrt(a);
+  return k * c * c * c;
+}
 
 // Variance component of the GNSS/INS position prior, from the data: each
 // control crossing's discrepancy (database minus image-only position with
@@ -624,6 +632,7 @@ Eigen::Vector2d EstimateGnssSigma(const AdjustmentOptions& options,
     sigma2[p.crossing] += p.sigma_m.cwiseAbs2() + covariance.diagonal();
   }
   double sum_h = 0.0, sum_v = 0.0, database_h = 0.0, database_v = 0.0;
+  double test_h = 0.0, test_v = 0.0;  // sum of squared normalised residuals
   int n = 0;
   const double offset2 =
       options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
@@ -640,15 +649,25 @@ Eigen::Vector2d EstimateGnssSigma(const AdjustmentOptions& options,
     sum_h += 0.5 * median.head<2>().squaredNorm();
     sum_v += median.z() * median.z();
     const Eigen::Vector3d mean_sigma2 = sigma2[c] / (m * m);
-    database_h += offset2 + 0.5 * (mean_sigma2.x() + mean_sigma2.y());
-    database_v += offset2 + mean_sigma2.z();
+    const double variance_h =
+        offset2 + 0.5 * (mean_sigma2.x() + mean_sigma2.y());
+    const double variance_v = offset2 + mean_sigma2.z();
+    database_h += variance_h;
+    database_v += variance_v;
+    test_h += median.head<2>().squaredNorm() / variance_h;
+    test_v += median.z() * median.z() / variance_v;
     ++n;
   }
   if (n == 0) return upper;
   const double floor2 = options.min_gnss_sigma_m * options.min_gnss_sigma_m;
+  // A drift is estimated only where the discrepancies exceed what the
+  // database's error explains (chi-square test at 95%): with one or two
+  // crossings the mean square is too noisy to trust on its own.
+  const bool drift_h = test_h > ChiSquare95(2 * n);
+  const bool drift_v = test_v > ChiSquare95(n);
   const Eigen::Vector2d estimate(
-      std::sqrt(std::max(floor2, (sum_h - database_h) / n)),
-      std::sqrt(std::max(floor2, (sum_v - database_v) / n)));
+      std::sqrt(drift_h ? std::max(floor2, (sum_h - database_h) / n) : floor2),
+      std::sqrt(drift_v ? std::max(floor2, (sum_v - database_v) / n) : floor2));
   return estimate.cwiseMin(upper);
 }
 }  // namespace
@@ -1067,11 +1086,10 @@ AdjustmentResult AdjustTrajectory(
     return true;
   };
   if (has_control || !state.ties.empty()) {
-    const bool any_check =
-        std::any_of(state.points.begin(), state.points.end(),
-                    [](const ControlPoint& p) {
-                      return p.status == ControlStatus::kCheck;
-                    });
+    const bool any_check = std::any_of(
+        state.points.begin(), state.points.end(), [](const ControlPoint& p) {
+          return p.status == ControlStatus::kCheck;
+        });
     if (!adjust()) return result;
     if (any_check && options.check_points_in_final) {
       // The check points' residuals are those of this adjustment, which
@@ -1083,9 +1101,8 @@ AdjustmentResult AdjustTrajectory(
         p.held_out_normalized_residual = p.normalized_residual;
         Eigen::Matrix3d covariance;
         p.held_out_triangulated = TriangulateWithState(
-            rig, state, p.observations, p.database_enu,
-            options.vertex_sigma_px, &p.held_out_enu, &covariance,
-            &p.held_out_rms_px);
+            rig, state, p.observations, p.database_enu, options.vertex_sigma_px,
+            &p.held_out_enu, &covariance, &p.held_out_rms_px);
         p.status = ControlStatus::kControl;
       }
       reset();
@@ -1275,13 +1292,13 @@ AdjustmentResult AdjustTrajectory(
       rms_px = p.held_out_rms_px;
     }
     const bool triangulated =
-        from_held_out ? p.held_out_triangulated
-                      : TriangulateWithState(
-                            rig, state, p.observations,
-                            p.status == ControlStatus::kControl
-                                ? p.estimate
-                                : p.database_enu,
-                            options.vertex_sigma_px, &X, &covariance, &rms_px);
+        from_held_out
+            ? p.held_out_triangulated
+            : TriangulateWithState(
+                  rig, state, p.observations,
+                  p.status == ControlStatus::kControl ? p.estimate
+                                                      : p.database_enu,
+                  options.vertex_sigma_px, &X, &covariance, &rms_px);
     r.image_enu = triangulated ? X : p.database_enu;
     if (p.status == ControlStatus::kControl) {
       r.adjusted_enu = p.estimate;

@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git clang libclang-rt-14-dev
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libopencv-contrib-dev libgeographiclib-dev
-  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libbz2-dev
+  libyaml-cpp-dev nlohmann-json3-dev libsimdjson-dev libcli11-dev libbz2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev
   python3 python3-numpy python3-opencv python3-yaml

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -147,9 +148,9 @@ inline std::vector<int> FeatureLines(const std::string& text) {
       }
       default:  // numbers, true, false, null
         value_starts();
+        static constexpr char kEnds[] = ",:[]{}\" \t\r\n";
         while (i < text.size() &&
-               std::string(",:[]{}\" \t\r\n").find(text[i]) ==
-                   std::string::npos) {
+               std::memchr(kEnds, text[i], sizeof(kEnds) - 1) == nullptr) {
           ++i;
         }
         break;
@@ -158,23 +159,13 @@ inline std::vector<int> FeatureLines(const std::string& text) {
   return lines;
 }
 
-// Reads one [lon, lat, h] position. Returns "" or the problem.
-inline std::string ReadPosition(const nlohmann::json& position,
-                                Geodetic* geodetic) {
-  if (!position.is_array()) return "is not an array [lon, lat, h]";
-  if (position.size() == 2) {
-    return "has no height: [lon, lat] but heights are required ([lon, lat, "
-           "h], ellipsoidal metres)";
-  }
-  if (position.size() != 3) {
-    return "has " + std::to_string(position.size()) +
-           " numbers; expected [lon, lat, h]";
-  }
-  double values[3];
-  for (int k = 0; k < 3; ++k) {
-    if (!position[k].is_number()) return "holds a value that is not a number";
-    values[k] = position[k].get<double>();
-    if (!std::isfinite(values[k])) return "holds a non-finite number";
+// Checks the ranges of a [lon, lat, h] position read as numbers. Returns ""
+// (and fills `geodetic`) or the problem. Shared by the readers of every JSON
+// library used here, so that they accept and word the same.
+inline std::string CheckPosition(const double (&values)[3],
+                                 Geodetic* geodetic) {
+  for (double value : values) {
+    if (!std::isfinite(value)) return "holds a non-finite number";
   }
   if (values[0] < -180.0 || values[0] > 180.0) {
     return "longitude " + FormatDouble(values[0]) + " is outside [-180, 180]";
@@ -186,6 +177,32 @@ inline std::string ReadPosition(const nlohmann::json& position,
   geodetic->lat_deg = values[1];
   geodetic->h_m = values[2];
   return "";
+}
+
+// The problem of a position array of `size` elements, "" when it is 3.
+inline std::string PositionSizeProblem(size_t size) {
+  if (size == 2) {
+    return "has no height: [lon, lat] but heights are required ([lon, lat, "
+           "h], ellipsoidal metres)";
+  }
+  if (size != 3) {
+    return "has " + std::to_string(size) + " numbers; expected [lon, lat, h]";
+  }
+  return "";
+}
+
+// Reads one [lon, lat, h] position. Returns "" or the problem.
+inline std::string ReadPosition(const nlohmann::json& position,
+                                Geodetic* geodetic) {
+  if (!position.is_array()) return "is not an array [lon, lat, h]";
+  const std::string size_problem = PositionSizeProblem(position.size());
+  if (!size_problem.empty()) return size_problem;
+  double values[3];
+  for (int k = 0; k < 3; ++k) {
+    if (!position[k].is_number()) return "holds a value that is not a number";
+    values[k] = position[k].get<double>();
+  }
+  return CheckPosition(values, geodetic);
 }
 
 // "[lon, lat, h]" with every digit, for writers. Throws std::invalid_argument

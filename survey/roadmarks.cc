@@ -1,10 +1,12 @@
 #include "survey/roadmarks.h"
 
+#include <simdjson.h>
+
 #include <cmath>
 #include <fstream>
-#include <map>
-#include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
+#include <unordered_map>
 #include <utility>
 
 #include "survey/atomic_file.h"
@@ -14,8 +16,6 @@
 
 namespace zebrageo {
 namespace {
-
-using nlohmann::json;
 
 // A ring is closed when its last position repeats the first; writers that
 // round through another unit may leave a last-digit difference.
@@ -58,14 +58,45 @@ bool SegmentsIntersect(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
          (o3 == 0 && OnSegment(c, d, a)) || (o4 == 0 && OnSegment(c, d, b));
 }
 
+// Horizontal ENU offsets (metres) of geodetic points from `origin`, on the
+// tangent plane of the WGS84 ellipsoid: exact to ~1e-6 relative over the
+// metres of a band, and ~50x cheaper than a LocalFrame per band.
+class TangentPlane {
+ public:
+  explicit TangentPlane(const Geodetic& origin) : origin_(origin) {
+    constexpr double kA = 6378137.0;             // WGS84 semi-major axis
+    constexpr double kE2 = 6.69437999014132e-3;  // first eccentricity^2
+    constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+    const double s = std::sin(origin.lat_deg * kRadPerDeg);
+    const double w2 = 1.0 - kE2 * s * s;
+    const double prime_vertical = kA / std::sqrt(w2);
+    const double meridian = kA * (1.0 - kE2) / (w2 * std::sqrt(w2));
+    east_m_per_deg_ = (prime_vertical + origin.h_m) *
+                      std::cos(origin.lat_deg * kRadPerDeg) * kRadPerDeg;
+    north_m_per_deg_ = (meridian + origin.h_m) * kRadPerDeg;
+  }
+
+  Eigen::Vector2d Offset(const Geodetic& p) const {
+    double dlon = p.lon_deg - origin_.lon_deg;
+    // A band across the antimeridian.
+    if (dlon > 180.0) dlon -= 360.0;
+    if (dlon < -180.0) dlon += 360.0;
+    return Eigen::Vector2d(dlon * east_m_per_deg_,
+                           (p.lat_deg - origin_.lat_deg) * north_m_per_deg_);
+  }
+
+ private:
+  Geodetic origin_;
+  double east_m_per_deg_ = 0.0;
+  double north_m_per_deg_ = 0.0;
+};
+
 // "" or why the band's four corners make no usable polygon. Computed in a
 // tangent plane at the first corner, in metres: degrees are not isotropic.
 std::string DegeneracyOf(const std::array<Geodetic, 4>& corners) {
-  const LocalFrame frame(corners[0]);
+  const TangentPlane plane(corners[0]);
   std::array<Eigen::Vector2d, 4> p;
-  for (int i = 0; i < 4; ++i) {
-    p[i] = frame.EnuFromGeodetic(corners[i]).head<2>();
-  }
+  for (int i = 0; i < 4; ++i) p[i] = plane.Offset(corners[i]);
   for (int i = 0; i < 4; ++i) {
     for (int j = i + 1; j < 4; ++j) {
       if ((p[i] - p[j]).norm() < kRepeatedCornerM) {
@@ -91,46 +122,134 @@ std::string DegeneracyOf(const std::array<Geodetic, 4>& corners) {
   return "";
 }
 
+// JSON values as parsed by simdjson (DOM).
+using Element = simdjson::dom::element;
+using ElementType = simdjson::dom::element_type;
+
+bool IsObject(const Element& e) { return e.type() == ElementType::OBJECT; }
+bool IsArray(const Element& e) { return e.type() == ElementType::ARRAY; }
+bool IsString(const Element& e) { return e.type() == ElementType::STRING; }
+bool IsNull(const Element& e) { return e.type() == ElementType::NULL_VALUE; }
+bool IsInteger(const Element& e) {
+  return e.type() == ElementType::INT64 || e.type() == ElementType::UINT64;
+}
+bool IsNumber(const Element& e) {
+  return IsInteger(e) || e.type() == ElementType::DOUBLE;
+}
+// Call only on objects and arrays (returned by value: the simdjson_result
+// they come in is a temporary).
+simdjson::dom::object ObjectOf(const Element& e) {
+  return e.get_object().value_unsafe();
+}
+simdjson::dom::array ArrayOf(const Element& e) {
+  return e.get_array().value_unsafe();
+}
+// Call only on numbers.
+double NumberOf(const Element& e) { return e.get_double().value_unsafe(); }
+// Call only on strings.
+std::string StringOf(const Element& e) {
+  return std::string(e.get_string().value_unsafe());
+}
+// The value as JSON text, for messages ("1.5", "\"a,b\"").
+std::string Dump(const Element& e) { return simdjson::minify(e); }
+
+// The member `key` of `object` (an OBJECT element), or false. With repeated
+// keys the last one counts, as with nlohmann::json and most JSON readers.
+bool Member(const Element& object, std::string_view key, Element* value) {
+  bool found = false;
+  for (const simdjson::dom::key_value_pair field : ObjectOf(object)) {
+    if (field.key == key) {
+      *value = field.value;
+      found = true;
+    }
+  }
+  return found;
+}
+
+// Reads one [lon, lat, h] position. Returns "" or the problem (the words of
+// geojson_internal::ReadPosition).
+std::string ReadPosition(const Element& position, Geodetic* geodetic) {
+  if (!IsArray(position)) return "is not an array [lon, lat, h]";
+  const simdjson::dom::array values = ArrayOf(position);
+  const std::string size_problem =
+      geojson_internal::PositionSizeProblem(values.size());
+  if (!size_problem.empty()) return size_problem;
+  double numbers[3];
+  int k = 0;
+  for (const Element value : values) {
+    if (!IsNumber(value)) return "holds a value that is not a number";
+    numbers[k++] = NumberOf(value);
+  }
+  return geojson_internal::CheckPosition(numbers, geodetic);
+}
+
+// (crossing_id, band) pairs, hashed: a city holds 100,000 bands.
+struct BandKeyHash {
+  size_t operator()(const std::pair<std::string, int>& key) const {
+    return std::hash<std::string>()(key.first) * 31u +
+           std::hash<int>()(key.second);
+  }
+};
+
+// The parse runs on simdjson's DOM (a city-sized database is tens of MB:
+// nlohmann::json's DOM took seconds); nlohmann::json only words syntax
+// errors with their line, which simdjson does not give.
 class RoadmarkParser {
  public:
   RoadmarkParser(const std::string& text, std::string display_name)
       : text_(text), display_name_(std::move(display_name)) {}
 
   RoadmarkDatabase Parse() {
-    const json root = geojson_internal::ParseJson(text_, display_name_);
-    if (!root.is_object() || !root.contains("type") ||
-        root["type"] != "FeatureCollection") {
+    simdjson::dom::parser parser;
+    // nlohmann::json accepts a UTF-8 byte order mark; simdjson leaves it to
+    // the caller.
+    const size_t skip = text_.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+    Element root;
+    const simdjson::error_code error =
+        parser.parse(text_.data() + skip, text_.size() - skip).get(root);
+    if (error != simdjson::SUCCESS) {
+      // Throws the error with its line when nlohmann::json rejects the text
+      // too; otherwise (a limit of simdjson's, e.g. an integer beyond 64
+      // bits) says what simdjson found.
+      geojson_internal::ParseJson(text_, display_name_);
+      throw InputError(
+          display_name_, 0,
+          std::string("malformed JSON: ") + simdjson::error_message(error));
+    }
+    Element type;
+    if (!IsObject(root) || !Member(root, "type", &type) || !IsString(type) ||
+        StringOf(type) != "FeatureCollection") {
       throw InputError(display_name_, 1,
                        "not a GeoJSON FeatureCollection (\"type\": "
                        "\"FeatureCollection\" missing)");
     }
     CheckCrs(root);
-    const auto features = root.find("features");
-    if (features == root.end() || !features->is_array()) {
+    Element features;
+    if (!Member(root, "features", &features) || !IsArray(features)) {
       throw InputError(display_name_, 1,
                        "FeatureCollection has no \"features\" array");
     }
-    feature_lines_ = geojson_internal::FeatureLines(text_);
-    for (size_t i = 0; i < features->size(); ++i) {
-      ParseFeature((*features)[i], static_cast<int>(i));
-    }
+    const simdjson::dom::array list = ArrayOf(features);
+    database_.bands.reserve(list.size());
+    band_of_key_.reserve(list.size());
+    int index = 0;
+    for (const Element feature : list) ParseFeature(feature, index++);
     return std::move(database_);
   }
 
  private:
   // RFC 7946 coordinates are WGS84 lon/lat; an old-style "crs" member naming
   // a projected system would put metres where degrees belong.
-  void CheckCrs(const json& root) const {
-    const auto crs = root.find("crs");
-    if (crs == root.end() || crs->is_null()) return;
-    const json* name = nullptr;
-    if (crs->is_object() && crs->contains("properties") &&
-        (*crs)["properties"].is_object() &&
-        (*crs)["properties"].contains("name")) {
-      name = &(*crs)["properties"]["name"];
-    }
-    const std::string text =
-        name != nullptr && name->is_string() ? name->get<std::string>() : "";
+  void CheckCrs(const Element& root) const {
+    Element crs;
+    if (!Member(root, "crs", &crs) || IsNull(crs)) return;
+    Element properties;
+    Element name;
+    const bool named = IsObject(crs) &&
+                       Member(crs, "properties", &properties) &&
+                       IsObject(properties) &&
+                       Member(properties, "name", &name) && IsString(name);
+    const std::string text = named ? StringOf(name) : "";
     for (const char* ok : {"CRS84", "4326", "4979", "CRS:84"}) {
       if (text.find(ok) != std::string::npos) return;
     }
@@ -140,7 +259,11 @@ class RoadmarkParser {
                          "(RFC 7946); reproject the file");
   }
 
+  // Lines are only needed for messages: the text is scanned for them then.
   int LineOfFeature(int index) const {
+    if (feature_lines_.empty()) {
+      feature_lines_ = geojson_internal::FeatureLines(text_);
+    }
     return index < static_cast<int>(feature_lines_.size())
                ? feature_lines_[index]
                : 0;
@@ -148,132 +271,140 @@ class RoadmarkParser {
 
   // "feature 12 (crossing 'C3', band 2)": the 1-based feature number and
   // whatever identifies it, for messages.
-  static std::string Describe(const json& feature, int index) {
+  static std::string Describe(const Element& feature, int index) {
     std::string label = "feature " + std::to_string(index + 1);
-    if (!feature.is_object() || !feature.contains("properties") ||
-        !feature["properties"].is_object()) {
+    Element properties;
+    if (!IsObject(feature) || !Member(feature, "properties", &properties) ||
+        !IsObject(properties)) {
       return label;
     }
-    const json& properties = feature["properties"];
     std::string details;
-    const auto crossing = properties.find("crossing_id");
-    if (crossing != properties.end() &&
-        (crossing->is_string() || crossing->is_number_integer())) {
+    Element crossing;
+    if (Member(properties, "crossing_id", &crossing) &&
+        (IsString(crossing) || IsInteger(crossing))) {
       details = "crossing '" +
-                (crossing->is_string() ? crossing->get<std::string>()
-                                       : crossing->dump()) +
+                (IsString(crossing) ? StringOf(crossing) : Dump(crossing)) +
                 "'";
     }
-    const auto band = properties.find("band");
-    if (band != properties.end() && band->is_number()) {
+    Element band;
+    if (Member(properties, "band", &band) && IsNumber(band)) {
       details +=
-          (details.empty() ? "" : ", ") + std::string("band ") + band->dump();
+          (details.empty() ? "" : ", ") + std::string("band ") + Dump(band);
     }
-    const auto type = properties.find("type");
-    if (details.empty() && type != properties.end() && type->is_string()) {
-      details = "type '" + type->get<std::string>() + "'";
+    Element type;
+    if (details.empty() && Member(properties, "type", &type) &&
+        IsString(type)) {
+      details = "type '" + StringOf(type) + "'";
     }
     return details.empty() ? label : label + " (" + details + ")";
   }
 
-  [[noreturn]] void Fail(const json& feature, int index,
+  [[noreturn]] void Fail(const Element& feature, int index,
                          const std::string& problem) const {
     throw InputError(display_name_, LineOfFeature(index),
                      Describe(feature, index) + ": " + problem);
   }
 
-  void ParseFeature(const json& feature, int index) {
-    if (!feature.is_object()) Fail(feature, index, "is not a JSON object");
-    const auto geometry = feature.find("geometry");
+  void ParseFeature(const Element& feature, int index) {
+    if (!IsObject(feature)) Fail(feature, index, "is not a JSON object");
+    Element geometry;
     // RFC 7946 allows unlocated features (geometry null): nothing to use.
-    if (geometry == feature.end() || geometry->is_null()) return;
-    if (!geometry->is_object() || !geometry->contains("type") ||
-        !(*geometry)["type"].is_string()) {
+    if (!Member(feature, "geometry", &geometry) || IsNull(geometry)) return;
+    Element type_value;
+    if (!IsObject(geometry) || !Member(geometry, "type", &type_value) ||
+        !IsString(type_value)) {
       Fail(feature, index, "geometry has no \"type\"");
     }
-    const json empty = json::object();
-    const json& properties =
-        feature.contains("properties") && feature["properties"].is_object()
-            ? feature["properties"]
-            : empty;
-    const std::string type = (*geometry)["type"].get<std::string>();
-    const bool has_band_properties =
-        properties.contains("crossing_id") || properties.contains("band");
+    Element properties;
+    const bool has_properties =
+        Member(feature, "properties", &properties) && IsObject(properties);
+    Element unused;
+    auto has = [&](std::string_view key) {
+      return has_properties && Member(properties, key, &unused);
+    };
+    const std::string type = StringOf(type_value);
+    const bool has_band_properties = has("crossing_id") || has("band");
     if (type == "Polygon" || type == "MultiPolygon") {
       // A polygon with a road-mark "type" but no crossing (an arrow, a
       // painted island) is another road mark: ignored like other types.
-      if (!has_band_properties && properties.contains("type")) return;
-      ParseBand(feature, *geometry, properties, index);
+      if (!has_band_properties && has("type")) return;
+      ParseBand(feature, geometry, type == "MultiPolygon",
+                has_properties ? &properties : nullptr, index);
     } else if (type == "LineString") {
-      if (!properties.contains("type")) return;
-      ParseLine(feature, *geometry, properties, index);
+      if (!has("type")) return;
+      ParseLine(feature, geometry, properties, index);
     }
     // Points, MultiLineStrings...: not used.
   }
 
-  const json& Coordinates(const json& feature, const json& geometry,
-                          int index) const {
-    const auto coordinates = geometry.find("coordinates");
-    if (coordinates == geometry.end() || !coordinates->is_array()) {
+  simdjson::dom::array Coordinates(const Element& feature,
+                                   const Element& geometry, int index) const {
+    Element coordinates;
+    if (!Member(geometry, "coordinates", &coordinates) ||
+        !IsArray(coordinates)) {
       Fail(feature, index, "geometry has no \"coordinates\" array");
     }
-    return *coordinates;
+    return ArrayOf(coordinates);
   }
 
-  double Sigma(const json& feature, const json& properties, const char* key,
-               int index, const double* default_value) const {
-    const auto it = properties.find(key);
-    if (it == properties.end() || it->is_null()) {
+  // `properties` may be null (no properties object).
+  double Sigma(const Element& feature, const Element* properties,
+               const char* key, int index, const double* default_value) const {
+    Element value;
+    if (properties == nullptr || !Member(*properties, key, &value) ||
+        IsNull(value)) {
       if (default_value != nullptr) return *default_value;
       Fail(feature, index,
            std::string("missing property '") + key + "' (metres)");
     }
-    if (!it->is_number()) {
+    if (!IsNumber(value)) {
       Fail(feature, index,
            std::string("property '") + key + "' is not a number");
     }
-    const double value = it->get<double>();
-    if (!std::isfinite(value) || value < 0.0) {
+    const double sigma = NumberOf(value);
+    if (!std::isfinite(sigma) || sigma < 0.0) {
       Fail(feature, index,
-           std::string("property '") + key + "' = " + it->dump() +
+           std::string("property '") + key + "' = " + Dump(value) +
                ": must be a finite number >= 0");
     }
-    return value;
+    return sigma;
   }
 
-  void ParseBand(const json& feature, const json& geometry,
-                 const json& properties, int index) {
-    const json* polygon = &Coordinates(feature, geometry, index);
-    if (geometry["type"] == "MultiPolygon") {
+  void ParseBand(const Element& feature, const Element& geometry,
+                 bool multi_polygon, const Element* properties, int index) {
+    simdjson::dom::array polygon = Coordinates(feature, geometry, index);
+    if (multi_polygon) {
       // GIS exports often promote polygons to one-part multipolygons.
-      if (polygon->size() != 1) {
+      if (polygon.size() != 1) {
         Fail(feature, index,
              "a band must be one Polygon; this MultiPolygon has " +
-                 std::to_string(polygon->size()) + " parts");
+                 std::to_string(polygon.size()) + " parts");
       }
-      polygon = &(*polygon)[0];
-      if (!polygon->is_array()) Fail(feature, index, "malformed MultiPolygon");
+      const Element part = polygon.at(0).value_unsafe();
+      if (!IsArray(part)) Fail(feature, index, "malformed MultiPolygon");
+      polygon = ArrayOf(part);
     }
-    if (polygon->size() != 1) {
+    if (polygon.size() != 1) {
       Fail(feature, index,
-           "polygon has " + std::to_string(polygon->size()) +
+           "polygon has " + std::to_string(polygon.size()) +
                " rings; a band has exactly one (no holes)");
     }
-    const json& ring = (*polygon)[0];
-    if (!ring.is_array() || ring.size() != 5) {
+    const Element ring = polygon.at(0).value_unsafe();
+    const size_t ring_size = IsArray(ring) ? ArrayOf(ring).size() : 0;
+    if (!IsArray(ring) || ring_size != 5) {
       Fail(feature, index,
-           "ring has " +
-               (ring.is_array() ? std::to_string(ring.size()) : "no") +
+           "ring has " + (IsArray(ring) ? std::to_string(ring_size) : "no") +
                " positions; a band needs 5 (4 corners, then the first "
                "again)");
     }
     std::array<Geodetic, 5> positions;
-    for (int k = 0; k < 5; ++k) {
-      const std::string problem =
-          geojson_internal::ReadPosition(ring[k], &positions[k]);
+    int k = 0;
+    for (const Element position : ArrayOf(ring)) {
+      const std::string problem = ReadPosition(position, &positions[k]);
       if (!problem.empty()) {
         Fail(feature, index, "position " + std::to_string(k) + " " + problem);
       }
+      ++k;
     }
     if (std::abs(positions[4].lon_deg - positions[0].lon_deg) >
             kClosureToleranceDeg ||
@@ -287,104 +418,111 @@ class RoadmarkParser {
     std::copy(positions.begin(), positions.begin() + 4, band.corners.begin());
 
     band.crossing_id = CrossingId(feature, properties, index);
-    const auto band_number = properties.find("band");
-    if (band_number == properties.end() || band_number->is_null()) {
+    Element band_number;
+    if (!Member(*properties, "band", &band_number) || IsNull(band_number)) {
       Fail(feature, index, "missing property 'band' (1-based integer)");
     }
-    if (!band_number->is_number() ||
-        band_number->get<double>() != std::floor(band_number->get<double>()) ||
-        band_number->get<double>() < 1.0 || band_number->get<double>() > 1e6) {
+    const double number = IsNumber(band_number) ? NumberOf(band_number) : 0.0;
+    if (!IsNumber(band_number) || number != std::floor(number) ||
+        number < 1.0 || number > 1e6) {
       Fail(feature, index,
-           "property 'band' = " + band_number->dump() +
+           "property 'band' = " + Dump(band_number) +
                ": must be an integer >= 1");
     }
-    band.band = static_cast<int>(band_number->get<double>());
+    band.band = static_cast<int>(number);
     band.sigma_xy_m = Sigma(feature, properties, "sigma_xy", index, nullptr);
     band.sigma_z_m = Sigma(feature, properties, "sigma_z", index, nullptr);
 
     const std::string degenerate = DegeneracyOf(band.corners);
     if (!degenerate.empty()) Fail(feature, index, degenerate);
 
-    const auto key = std::make_pair(band.crossing_id, band.band);
-    const auto [it, inserted] =
-        line_of_band_.emplace(key, LineOfFeature(index));
+    const auto [it, inserted] = band_of_key_.emplace(
+        std::make_pair(band.crossing_id, band.band), index);
     if (!inserted) {
       Fail(feature, index,
            "duplicate band: crossing '" + band.crossing_id + "' band " +
                std::to_string(band.band) + " already appears on line " +
-               std::to_string(it->second));
+               std::to_string(LineOfFeature(it->second)));
     }
     database_.bands.push_back(std::move(band));
   }
 
-  std::string CrossingId(const json& feature, const json& properties,
+  // `properties` may be null (no properties object).
+  std::string CrossingId(const Element& feature, const Element* properties,
                          int index) const {
-    const auto it = properties.find("crossing_id");
-    if (it == properties.end() || it->is_null()) {
+    Element value;
+    if (properties == nullptr || !Member(*properties, "crossing_id", &value) ||
+        IsNull(value)) {
       Fail(feature, index, "missing property 'crossing_id'");
     }
     std::string id;
-    if (it->is_string()) {
-      id = it->get<std::string>();
-    } else if (it->is_number_integer()) {
+    if (IsString(value)) {
+      id = StringOf(value);
+    } else if (IsInteger(value)) {
       // Some GIS tools write numeric ids; they name the same crossing.
-      id = it->dump();
+      id = Dump(value);
     } else {
       Fail(feature, index,
-           "property 'crossing_id' = " + it->dump() +
+           "property 'crossing_id' = " + Dump(value) +
                " is neither a string nor an integer");
     }
     // The id is written to matches.csv and crossing_decisions.csv.
     if (id.empty() || id.find_first_of(",\"\n\r") != std::string::npos ||
         id.front() == ' ' || id.back() == ' ') {
       Fail(feature, index,
-           "property 'crossing_id' " + it->dump() +
+           "property 'crossing_id' " + Dump(value) +
                " must be non-empty, without ',', '\"', line breaks or "
                "leading/trailing spaces (it is written to CSV files)");
     }
     return id;
   }
 
-  void ParseLine(const json& feature, const json& geometry,
-                 const json& properties, int index) {
-    const json& coordinates = Coordinates(feature, geometry, index);
+  void ParseLine(const Element& feature, const Element& geometry,
+                 const Element& properties, int index) {
+    const simdjson::dom::array coordinates =
+        Coordinates(feature, geometry, index);
     if (coordinates.size() < 2) {
       Fail(feature, index, "a LineString needs at least 2 positions");
     }
     RoadmarkLine line;
-    const json& type = properties["type"];
-    if (!type.is_string()) {
+    Element type;
+    Member(properties, "type", &type);
+    if (!IsString(type)) {
       Fail(feature, index, "property 'type' is not a string");
     }
-    line.type = type.get<std::string>();
-    const auto id = properties.find("id");
-    if (id != properties.end() && id->is_string()) {
-      line.id = id->get<std::string>();
-    } else if (id != properties.end() && id->is_number_integer()) {
-      line.id = id->dump();
+    line.type = StringOf(type);
+    Element id;
+    const bool has_id = Member(properties, "id", &id);
+    if (has_id && IsString(id)) {
+      line.id = StringOf(id);
+    } else if (has_id && IsInteger(id)) {
+      line.id = Dump(id);
     } else {
       line.id = "line-" + std::to_string(database_.lines.size());
     }
-    for (size_t k = 0; k < coordinates.size(); ++k) {
+    int k = 0;
+    for (const Element position : coordinates) {
       Geodetic point;
-      const std::string problem =
-          geojson_internal::ReadPosition(coordinates[k], &point);
+      const std::string problem = ReadPosition(position, &point);
       if (!problem.empty()) {
         Fail(feature, index, "position " + std::to_string(k) + " " + problem);
       }
       line.points.push_back(point);
+      ++k;
     }
     line.sigma_xy_m =
-        Sigma(feature, properties, "sigma_xy", index, &kDefaultLineSigmaXyM);
+        Sigma(feature, &properties, "sigma_xy", index, &kDefaultLineSigmaXyM);
     line.sigma_z_m =
-        Sigma(feature, properties, "sigma_z", index, &kDefaultLineSigmaZM);
+        Sigma(feature, &properties, "sigma_z", index, &kDefaultLineSigmaZM);
     database_.lines.push_back(std::move(line));
   }
 
   const std::string& text_;
   std::string display_name_;
-  std::vector<int> feature_lines_;
-  std::map<std::pair<std::string, int>, int> line_of_band_;
+  mutable std::vector<int> feature_lines_;
+  // (crossing_id, band) -> index of the feature that has it.
+  std::unordered_map<std::pair<std::string, int>, int, BandKeyHash>
+      band_of_key_;
   RoadmarkDatabase database_;
 };
 

@@ -197,8 +197,8 @@ TEST(TrajectoryAdjuster, CheckCrossingsAreControlInTheFinalAdjustment) {
   EXPECT_NEAR(final_result.summary.check_rmse_horizontal_m,
               held_out.summary.check_rmse_horizontal_m, 1e-6);
   EXPECT_GT(final_result.summary.num_check_points, 0);
-  const double e_final = ScorePoses(f.survey, final_result.camera_poses)
-                             .rmse_horizontal_m;
+  const double e_final =
+      ScorePoses(f.survey, final_result.camera_poses).rmse_horizontal_m;
   const double e_all = ScorePoses(f.survey, all.camera_poses).rmse_horizontal_m;
   EXPECT_NEAR(e_final, e_all, 0.002);
 }
