@@ -84,6 +84,8 @@ struct State {
   std::vector<std::array<double, kRigCorrectionSize>> rig_corrections;
   std::vector<ControlPoint> points;
   std::vector<TiePoint> ties;
+  // Matched road-line points with the INS pose at their time.
+  std::vector<std::pair<LineControlPoint, Pose>> lines;
   // Centre of the GNSS/INS prior of each knot: 0, or the jumps removed
   // from the trajectory before the knot (track frame).
   std::vector<Eigen::Matrix<double, 6, 1>> knot_prior;
@@ -301,6 +303,7 @@ class AdjustmentProblem {
       control_loss_ =
           std::make_unique<ceres::CauchyLoss>(options.control_loss_scale);
       gnss_loss_ = std::make_unique<ceres::CauchyLoss>(options.gnss_loss_scale);
+      line_loss_ = std::make_unique<ceres::CauchyLoss>(options.line_loss_scale);
     }
     Build();
   }
@@ -501,6 +504,16 @@ class AdjustmentProblem {
                          &blocks_.tie_images);
       }
     }
+    for (const auto& [line, ins_pose] : state_->lines) {
+      int first = 0;
+      double w[4];
+      state_->correction.Basis(line.time, &first, w);
+      problem_->AddResidualBlock(
+          LinePointCost::Create(line, ins_pose,
+                                state_->correction.Frame(ins_pose), w),
+          line_loss_.get(), knots[first].data(), knots[first + 1].data(),
+          knots[first + 2].data(), knots[first + 3].data());
+    }
   }
 
   const AdjustmentOptions& options_;
@@ -510,6 +523,7 @@ class AdjustmentProblem {
   std::unique_ptr<ceres::LossFunction> image_loss_;
   std::unique_ptr<ceres::LossFunction> control_loss_;
   std::unique_ptr<ceres::LossFunction> gnss_loss_;
+  std::unique_ptr<ceres::LossFunction> line_loss_;
   Blocks blocks_;
   int num_pose_blocks_ = 0;
 };
@@ -709,6 +723,7 @@ std::string AdjustmentOptions::Check() const {
       {"blunder_threshold", blunder_threshold},
       {"blunder_sigma_floor_m", blunder_sigma_floor_m},
       {"tie_sigma_px", tie_sigma_px},
+      {"line_loss_scale", line_loss_scale},
       {"boresight_sigma_deg", boresight_sigma_deg},
       {"lever_arm_sigma_m", lever_arm_sigma_m},
   };
@@ -948,6 +963,14 @@ AdjustmentResult AdjustTrajectory(
     }
   }
   summary.num_tie_tracks = static_cast<int>(state.ties.size());
+  if (input.line_points != nullptr) {
+    for (const LineControlPoint& line : *input.line_points) {
+      Pose ins_pose;
+      if (ins_pose_at(line.time, &ins_pose)) {
+        state.lines.emplace_back(line, ins_pose);
+      }
+    }
+  }
 
   state.correction =
       TrajectoryCorrection(trajectory.start_time(), trajectory.end_time(),
@@ -1085,7 +1108,7 @@ AdjustmentResult AdjustTrajectory(
     summary.sigma0 = problem->Sigma0();
     return true;
   };
-  if (has_control || !state.ties.empty()) {
+  if (has_control || !state.ties.empty() || !state.lines.empty()) {
     const bool any_check = std::any_of(
         state.points.begin(), state.points.end(), [](const ControlPoint& p) {
           return p.status == ControlStatus::kCheck;

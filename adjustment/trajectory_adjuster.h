@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "adjustment/line_control.h"
 #include "adjustment/solver_options.h"
 #include "adjustment/tie_points.h"
 #include "adjustment/trajectory_correction.h"
@@ -135,6 +136,9 @@ struct AdjustmentOptions {
   // rejected whole (repainted, wrongly matched).
   double reject_crossing_share = 0.5;
 
+  // ---------------------------------------------------- road lines
+  // Cauchy loss on the point-to-line residuals (line_control.h), in sigmas.
+  double line_loss_scale = 3.0;
   // ---------------------------------------------------- tie points
   double tie_sigma_px = 1.0;
 
@@ -169,6 +173,8 @@ struct AdjustmentInput {
   const std::vector<ReconstructedVertex>* vertices = nullptr;
   const std::vector<VertexMatch>* matches = nullptr;
   const std::vector<TieTrack>* tie_tracks = nullptr;
+  // Matched road-line points (issue 9), optional.
+  const std::vector<LineControlPoint>* line_points = nullptr;
 };
 
 enum class ControlStatus {

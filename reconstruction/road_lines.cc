@@ -607,15 +607,23 @@ bool StereoLineExtractor::Finish(RoadLine3d* line) const {
   return true;
 }
 
+namespace {
+const std::vector<std::string>& LineColumns() {
+  static const std::vector<std::string> columns = {
+      "exposure_id", "pair",   "line_id", "type",   "point",   "x",
+      "y",           "z",      "cov_xx",  "cov_xy", "cov_xz",  "cov_yy",
+      "cov_yz",      "cov_zz", "u_left",  "v_left", "u_right", "v_right"};
+  return columns;
+}
+}  // namespace
+
 void WriteReconstructedLines(const std::vector<ReconstructedLinePoint>& points,
                              const std::vector<std::string>& comments,
                              const std::string& path) {
   AtomicFile file(path);
   CsvWriter csv(&file.stream());
   for (const std::string& comment : comments) csv.Comment(comment);
-  csv.Header({"exposure_id", "pair", "line_id", "type", "point", "x", "y", "z",
-              "cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz",
-              "u_left", "v_left", "u_right", "v_right"});
+  csv.Header(LineColumns());
   for (const ReconstructedLinePoint& p : points) {
     const Eigen::Matrix3d& c = p.covariance_body;
     csv.Add(p.exposure_id)
@@ -639,6 +647,47 @@ void WriteReconstructedLines(const std::vector<ReconstructedLinePoint>& points,
     csv.EndRow();
   }
   file.Commit();
+}
+
+std::vector<ReconstructedLinePoint> ReadReconstructedLines(
+    const std::string& path, const std::string& display_name) {
+  const CsvTable csv = CsvTable::Read(path, display_name, LineColumns());
+  std::vector<ReconstructedLinePoint> points;
+  for (int row = 0; row < csv.NumRows(); ++row) {
+    ReconstructedLinePoint p;
+    p.exposure_id = csv.GetInt(row, "exposure_id");
+    p.pair = static_cast<int>(csv.GetInt(row, "pair"));
+    p.line_id = csv.GetInt(row, "line_id");
+    const std::string& type = csv.GetString(row, "type");
+    if (type == "lane_solid") {
+      p.type = RoadLineType::kLaneSolid;
+    } else if (type == "lane_dashed") {
+      p.type = RoadLineType::kLaneDashed;
+    } else if (type == "stop_line") {
+      p.type = RoadLineType::kStopLine;
+    } else {
+      csv.Fail(row, "type must be lane_solid, lane_dashed or stop_line");
+    }
+    p.point = static_cast<int>(csv.GetInt(row, "point"));
+    p.p_body = Eigen::Vector3d(csv.GetDouble(row, "x"), csv.GetDouble(row, "y"),
+                               csv.GetDouble(row, "z"));
+    Eigen::Matrix3d& c = p.covariance_body;
+    c(0, 0) = csv.GetDouble(row, "cov_xx");
+    c(0, 1) = c(1, 0) = csv.GetDouble(row, "cov_xy");
+    c(0, 2) = c(2, 0) = csv.GetDouble(row, "cov_xz");
+    c(1, 1) = csv.GetDouble(row, "cov_yy");
+    c(1, 2) = c(2, 1) = csv.GetDouble(row, "cov_yz");
+    c(2, 2) = csv.GetDouble(row, "cov_zz");
+    if (!(c(0, 0) >= 0.0 && c(1, 1) >= 0.0 && c(2, 2) >= 0.0)) {
+      csv.Fail(row, "a variance is negative");
+    }
+    p.uv_left = Eigen::Vector2d(csv.GetDouble(row, "u_left"),
+                                csv.GetDouble(row, "v_left"));
+    p.uv_right = Eigen::Vector2d(csv.GetDouble(row, "u_right"),
+                                 csv.GetDouble(row, "v_right"));
+    points.push_back(p);
+  }
+  return points;
 }
 
 std::string RoadLineSummary::BriefReport() const {

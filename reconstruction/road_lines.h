@@ -225,6 +225,11 @@ void WriteReconstructedLines(const std::vector<ReconstructedLinePoint>& points,
                              const std::vector<std::string>& comments,
                              const std::string& path);
 
+// Throws InputError naming the file and line (missing column, bad number,
+// unknown type, negative variance).
+std::vector<ReconstructedLinePoint> ReadReconstructedLines(
+    const std::string& path, const std::string& display_name);
+
 struct RoadLineSummary {
   int pairs = 0;
   int lines = 0;

@@ -21,6 +21,7 @@ namespace {
 struct AdjustArguments {
   StageArguments stage;
   bool tie_points = true;
+  bool lines = true;
   bool self_calibrate = false;
   double check_share = AdjustmentOptions().check_crossing_share;
   int threads = AdjustmentOptions().solver.num_threads;
@@ -34,7 +35,7 @@ void RunAdjust(const AdjustArguments& args) {
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
   RunAdjustStage(args.stage.survey, args.stage.results, options,
-                 args.tie_points);
+                 args.tie_points, args.lines);
 }
 
 }  // namespace
@@ -42,7 +43,7 @@ void RunAdjust(const AdjustArguments& args) {
 std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
                                         const std::string& results_folder,
                                         const AdjustmentOptions& options,
-                                        bool tie_points) {
+                                        bool tie_points, bool lines) {
   const AdjustmentData data = LoadAdjustmentData(survey_folder, results_folder);
   LOG(INFO) << "adjust: " << data.vertices.size() << " reconstructed vertices, "
             << data.matches.size() << " matches, "
@@ -64,9 +65,19 @@ std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
   if (use_ties) input.tie_tracks = &tracks;
 
   ProgressBar bar("adjust");
-  const AdjustmentResult result =
-      AdjustTrajectory(options, input, bar.Callback());
+  AdjustmentResult result = AdjustTrajectory(options, input, bar.Callback());
   bar.Finish();
+  std::vector<std::string> warnings = data.warnings;
+  if (lines && result.summary.IsUsable()) {
+    const std::vector<LineControlPoint> line_points = MatchLinesForAdjustment(
+        data, options, result, results_folder, &warnings);
+    if (!line_points.empty()) {
+      input.line_points = &line_points;
+      ProgressBar line_bar("adjust with lines");
+      result = AdjustTrajectory(options, input, line_bar.Callback());
+      line_bar.Finish();
+    }
+  }
   if (!result.summary.IsUsable()) {
     throw StageFailedError("adjust: " + result.summary.message +
                            "; no results were written");
@@ -75,7 +86,7 @@ std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
   WriteAdjustmentResults(data, options, result,
                          use_ties ? &tie_summary : nullptr, results_folder);
   LOG(INFO) << "adjust: " << result.summary.BriefReport();
-  return data.warnings;
+  return warnings;
 }
 
 void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands) {
@@ -88,6 +99,8 @@ void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands) {
       &args->stage);
   sub->add_flag("!--no-tie-points", args->tie_points,
                 "do not match image features between exposures");
+  sub->add_flag("!--no-lines", args->lines,
+                "zebra crossings alone: do not use reconstructed_lines.csv");
   sub->add_flag("--self-calibrate", args->self_calibrate,
                 "estimate each camera's boresight and lever arm");
   sub->add_option("--check-share", args->check_share,

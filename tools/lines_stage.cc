@@ -1,16 +1,51 @@
 // The road-line stage (issue 9): reconstructed_lines.csv from the stereo
-// pairs, on the road plane the zebra stage estimated.
+// pairs, on the road plane the zebra stage estimated; and the road lines as
+// control in the adjustment (matched with the trajectory the zebra
+// crossings corrected, then a second adjustment with the lines).
 #include <glog/logging.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <map>
+#include <sstream>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "reconstruction/road_lines.h"
+#include "registration/line_matcher.h"
+#include "survey/atomic_file.h"
+#include "survey/csv.h"
 #include "tools/exit_codes.h"
 #include "tools/stages.h"
 
 namespace zebrageo {
+namespace {
+
+// The corrected body pose at `time` (linear in position, slerp in
+// attitude between the corrected samples); false outside them.
+bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
+  const auto& samples = result.corrected_samples;
+  if (samples.size() < 2 || time < samples.front().time ||
+      time > samples.back().time) {
+    return false;
+  }
+  const auto it = std::upper_bound(
+      samples.begin(), samples.end(), time,
+      [](double t, const TrajectorySample& s) { return t < s.time; });
+  const size_t i = std::min<size_t>(
+      std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
+  const double span = samples[i + 1].time - samples[i].time;
+  const double u = span > 0.0 ? (time - samples[i].time) / span : 0.0;
+  const Pose& a = result.corrected_poses[i];
+  const Pose& b = result.corrected_poses[i + 1];
+  pose->p_enu = (1.0 - u) * a.p_enu + u * b.p_enu;
+  pose->q_enu_body = a.q_enu_body.slerp(u, b.q_enu_body);
+  return true;
+}
+
+}  // namespace
 
 std::vector<std::string> RunRoadLinesStage(
     const Survey& survey, const RoadPlane& road_plane,
@@ -31,6 +66,106 @@ std::vector<std::string> RunRoadLinesStage(
           .string());
   LOG(INFO) << "road lines: " << summary.BriefReport();
   return warnings;
+}
+
+std::vector<LineControlPoint> MatchLinesForAdjustment(
+    const AdjustmentData& data, const AdjustmentOptions& options,
+    const AdjustmentResult& zebra_result, const std::string& results_folder,
+    std::vector<std::string>* warnings) {
+  std::vector<LineControlPoint> control;
+  const std::string path =
+      (std::filesystem::path(results_folder) / kReconstructedLinesFile)
+          .string();
+  if (!std::filesystem::exists(path)) return control;
+  if (data.roadmarks.lines.empty()) {
+    warnings->push_back(
+        "the road-mark database has no lines: road lines not used");
+    return control;
+  }
+  const std::vector<ReconstructedLinePoint> points =
+      ReadReconstructedLines(path, kReconstructedLinesFile);
+  std::unordered_map<int64_t, double> exposure_time;
+  for (const Exposure& e : data.exposures.exposures) {
+    exposure_time[e.exposure_id] = e.time;
+  }
+  // In ENU with the trajectory the zebra crossings corrected.
+  std::vector<LinePointEnu> enu;
+  std::vector<int> source;
+  std::vector<Pose> pose_of;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto t = exposure_time.find(points[i].exposure_id);
+    Pose pose;
+    if (t == exposure_time.end() ||
+        !CorrectedPoseAt(zebra_result, t->second, &pose)) {
+      continue;
+    }
+    enu.push_back({points[i].line_id, RoadLineTypeName(points[i].type),
+                   pose.T_enu_body() * points[i].p_body});
+    source.push_back(static_cast<int>(i));
+    pose_of.push_back(pose);
+  }
+  const std::vector<DatabaseLineEnu> database =
+      DatabaseLinesEnu(data.roadmarks, data.frame);
+  const std::vector<LinePointMatch> matches =
+      MatchLinePoints(enu, database, LineMatchOptions());
+
+  AtomicFile file(
+      (std::filesystem::path(results_folder) / "line_matches.csv").string());
+  CsvWriter csv(&file.stream());
+  csv.Comment(
+      "road-line points matched to database lines (issue 9); each constrains "
+      "the position across the line (across_e, across_n) and the height, "
+      "never along the line");
+  // Per 30 s stretch: matches, and the directions controlled.
+  const double stretch_s = 30.0;
+  std::map<int, std::array<int, 3>> stretches;  // cross-track, height, along
+  csv.Header({"exposure_id", "line_id", "point", "type", "db_line", "across_e",
+              "across_n", "distance_m", "height_m", "constrains"});
+  for (const LinePointMatch& m : matches) {
+    const ReconstructedLinePoint& p = points[source[m.point]];
+    const Pose& pose = pose_of[m.point];
+    const DatabaseLineEnu& line = database[m.db_line];
+    LineControlPoint c;
+    c.time = exposure_time[p.exposure_id];
+    c.p_body = p.p_body;
+    c.db_point_enu = m.db_point_enu;
+    c.across_enu = m.across_enu;
+    c.sqrt_information = LineSqrtInformation(
+        p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
+        std::max(line.sigma_xy_m, options.min_database_sigma_m),
+        std::max(line.sigma_z_m, options.min_database_sigma_m));
+    control.push_back(c);
+    // Across the line is cross-track when the line runs with the vehicle.
+    const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
+    const bool cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
+    auto& s = stretches[static_cast<int>(std::floor(c.time / stretch_s))];
+    s[cross_track ? 0 : 2] += 1;
+    s[1] += 1;
+    csv.Add(p.exposure_id)
+        .Add(p.line_id)
+        .Add(p.point)
+        .Add(RoadLineTypeName(p.type))
+        .Add(line.id)
+        .Add(m.across_enu.x())
+        .Add(m.across_enu.y())
+        .Add(m.distance_m)
+        .Add(m.height_m)
+        .Add("across+height");
+    csv.EndRow();
+  }
+  file.Commit();
+  std::ostringstream report;
+  report << "road lines: " << matches.size() << " of " << points.size()
+         << " line points matched to database lines; per " << stretch_s
+         << " s stretch (cross-track/height/along-track points):";
+  for (const auto& [k, s] : stretches) {
+    report << " [" << k * stretch_s << " s: " << s[0] << "/" << s[1] << "/"
+           << s[2] << "]";
+  }
+  LOG(INFO) << report.str();
+  LOG(INFO) << "road lines control cross-track and height between crossings; "
+               "along-track only where stop lines match";
+  return control;
 }
 
 }  // namespace zebrageo

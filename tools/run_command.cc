@@ -24,6 +24,7 @@ struct RunArguments {
   std::string from_stage;
   int threads = 0;
   bool tie_points = true;
+  bool lines = true;  // road lines as control beside the zebras (issue 9)
 };
 
 double PeakMemoryMb() {
@@ -61,11 +62,22 @@ void Run(const RunArguments& args) {
   const std::string results = args.stage.results;
 
   std::vector<PipelineStage> stages;
-  stages.push_back({"reconstruct",
-                    {kReconstructedBandsFile},
+  std::vector<std::string> reconstruct_outputs = {kReconstructedBandsFile};
+  if (args.lines) reconstruct_outputs.push_back(kReconstructedLinesFile);
+  stages.push_back({"reconstruct", reconstruct_outputs,
                     [&](const std::function<void(int, int)>& progress) {
-                      return RunReconstructStage(survey, reconstruction,
-                                                 results, progress);
+                      RoadPlane road_plane;
+                      std::vector<std::string> warnings =
+                          RunReconstructStage(survey, reconstruction, results,
+                                              progress, &road_plane);
+                      if (args.lines) {
+                        for (const std::string& w : RunRoadLinesStage(
+                                 survey, road_plane, RoadLineOptions(),
+                                 args.threads, results, nullptr)) {
+                          warnings.push_back(w);
+                        }
+                      }
+                      return warnings;
                     }});
   stages.push_back({"match",
                     {kMatchesFile, kCrossingDecisionsFile},
@@ -84,10 +96,11 @@ void Run(const RunArguments& args) {
                      kBandsGeoJsonFile},
                     [&](const std::function<void(int, int)>&) {
                       return RunAdjustStage(survey.folder, results, adjustment,
-                                            args.tie_points);
+                                            args.tie_points, args.lines);
                     }});
   std::ostringstream settings;
-  settings << "threads-independent;ties=" << args.tie_points;
+  settings << "threads-independent;ties=" << args.tie_points
+           << ";lines=" << args.lines;
   const PipelineRun run = RunPipeline(
       results, InputFingerprint(SurveyInputFiles(survey), settings.str()),
       stages, PipelineOptions{args.from_stage});
@@ -122,6 +135,8 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
       ->check(CLI::NonNegativeNumber);
   run->add_flag("!--no-tie-points", run_args->tie_points,
                 "do not match image features between exposures");
+  run->add_flag("!--no-lines", run_args->lines,
+                "zebra crossings alone as control: no road lines");
   commands->push_back({run, [run_args] { Run(*run_args); }});
 
   auto report_args = std::make_shared<StageArguments>();

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "reconstruction/reconstruction.h"
 #include "reconstruction/road_lines.h"
@@ -34,10 +35,21 @@ std::vector<std::string> RunRoadLinesStage(
 // Writes trajectory_corrected.csv, poses.csv, gcp_residuals.csv,
 // bands.geojson, adjustment.json and colmap/. Draws its own progress bars
 // (tie points, then the solve).
+// With `lines` and a reconstructed_lines.csv, the adjustment runs twice:
+// zebra crossings alone, then with the road lines matched on that
+// trajectory (line_matches.csv).
 std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
                                         const std::string& results_folder,
                                         const AdjustmentOptions& options,
-                                        bool tie_points);
+                                        bool tie_points, bool lines = true);
+
+// The road-line points of results_folder/reconstructed_lines.csv matched to
+// the database lines with the trajectory of `zebra_result`, as control for
+// the adjustment; writes line_matches.csv. Empty without lines.
+std::vector<LineControlPoint> MatchLinesForAdjustment(
+    const AdjustmentData& data, const AdjustmentOptions& options,
+    const AdjustmentResult& zebra_result, const std::string& results_folder,
+    std::vector<std::string>* warnings);
 
 }  // namespace zebrageo
 

@@ -3,8 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <random>
+
+#include "survey/input_error.h"
 
 namespace zebrageo {
 namespace {
@@ -280,6 +284,47 @@ TEST(StereoLineExtractor, RecoversLanesAndStopLineNotTheZebra) {
   EXPECT_GE(dashed, 1);
   EXPECT_EQ(stop, 1);
   EXPECT_GT(result.wide_runs, 50);  // the zebra bands, seen and left out
+}
+
+TEST(ReconstructedLines, RoundTripAndClearErrors) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() /
+       ("road_lines_test_" +
+        std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+        ".csv"))
+          .string();
+  std::vector<ReconstructedLinePoint> points(2);
+  points[0].exposure_id = 7;
+  points[0].line_id = 3;
+  points[0].type = RoadLineType::kStopLine;
+  points[0].p_body = Eigen::Vector3d(10.1, -1.0 / 3.0, 2.5);
+  points[0].covariance_body << 1e-4, 1e-6, 2e-6, 1e-6, 3e-4, 4e-6, 2e-6, 4e-6,
+      5e-4;
+  points[1] = points[0];
+  points[1].point = 1;
+  points[1].type = RoadLineType::kLaneDashed;
+  WriteReconstructedLines(points, {"test"}, path);
+  const auto read = ReadReconstructedLines(path, "lines.csv");
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].type, RoadLineType::kStopLine);
+  EXPECT_EQ(read[1].type, RoadLineType::kLaneDashed);
+  EXPECT_EQ(read[0].p_body, points[0].p_body);  // exact: shortest round trip
+  EXPECT_EQ(read[1].covariance_body, points[0].covariance_body);
+  {
+    std::ifstream in(path);
+    std::string text((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
+    text.replace(text.rfind("lane_dashed"), 11, "zebra");
+    std::ofstream(path) << text;
+  }
+  try {
+    ReadReconstructedLines(path, "lines.csv");
+    ADD_FAILURE() << "an unknown type was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lines.csv:4"), std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace

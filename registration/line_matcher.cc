@@ -1,0 +1,148 @@
+#include "registration/line_matcher.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <sstream>
+
+namespace zebrageo {
+namespace {
+
+bool Compatible(const std::string& a, const std::string& b) {
+  const bool stop_a = a == "stop_line", stop_b = b == "stop_line";
+  const bool lane_a = a.rfind("lane_", 0) == 0,
+             lane_b = b.rfind("lane_", 0) == 0;
+  return (stop_a && stop_b) || (lane_a && lane_b);
+}
+
+// Nearest point (horizontally) of segment ab to p; t in [0, 1].
+double SegmentDistance2d(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b, double* t) {
+  const Eigen::Vector2d d = (b - a).head<2>();
+  const double l2 = d.squaredNorm();
+  *t = l2 > 0.0 ? std::clamp((p - a).head<2>().dot(d) / l2, 0.0, 1.0) : 0.0;
+  return (p.head<2>() - (a.head<2>() + *t * d)).norm();
+}
+
+struct Nearest {
+  int line = -1;
+  int segment = -1;
+  double t = 0.0;
+  double distance = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace
+
+std::string LineMatchOptions::Check() const {
+  std::ostringstream e;
+  if (!(gate_m > 0.0) || !(max_height_m > 0.0)) {
+    e << "gate_m and max_height_m must be positive";
+  } else if (!(min_separation_ratio >= 1.0)) {
+    e << "min_separation_ratio must be at least 1";
+  } else if (!(max_angle_rad > 0.0 && max_angle_rad < M_PI / 2)) {
+    e << "max_angle_rad must be in (0, pi/2)";
+  } else if (!(min_matched_share > 0.0 && min_matched_share <= 1.0)) {
+    e << "min_matched_share must be in (0, 1]";
+  }
+  const std::string error = e.str();
+  return error.empty() ? error : "line matching options: " + error;
+}
+
+std::vector<DatabaseLineEnu> DatabaseLinesEnu(const RoadmarkDatabase& database,
+                                              const LocalFrame& frame) {
+  std::vector<DatabaseLineEnu> out;
+  for (const RoadmarkLine& line : database.lines) {
+    if (line.points.size() < 2) continue;
+    DatabaseLineEnu enu;
+    enu.id = line.id;
+    enu.type = line.type;
+    enu.sigma_xy_m = line.sigma_xy_m;
+    enu.sigma_z_m = line.sigma_z_m;
+    for (const Geodetic& g : line.points) {
+      enu.points.push_back(frame.EnuFromGeodetic(g));
+    }
+    out.push_back(std::move(enu));
+  }
+  return out;
+}
+
+std::vector<LinePointMatch> MatchLinePoints(
+    const std::vector<LinePointEnu>& points,
+    const std::vector<DatabaseLineEnu>& database,
+    const LineMatchOptions& options) {
+  std::vector<LinePointMatch> out;
+  size_t begin = 0;
+  while (begin < points.size()) {
+    size_t end = begin + 1;
+    while (end < points.size() &&
+           points[end].line_id == points[begin].line_id) {
+      ++end;
+    }
+    // The reconstructed line's direction (first to last point).
+    Eigen::Vector2d direction =
+        (points[end - 1].p_enu - points[begin].p_enu).head<2>();
+    const bool has_direction = direction.norm() > 0.3;
+    direction.normalize();
+    std::vector<LinePointMatch> matches;
+    std::map<int, int> votes;
+    for (size_t i = begin; i < end; ++i) {
+      const LinePointEnu& p = points[i];
+      // Nearest compatible line, and the nearest other line of any type.
+      Nearest best, second;
+      for (int l = 0; l < static_cast<int>(database.size()); ++l) {
+        const DatabaseLineEnu& line = database[l];
+        Nearest n;
+        for (size_t s = 0; s + 1 < line.points.size(); ++s) {
+          double t = 0.0;
+          const double d = SegmentDistance2d(p.p_enu, line.points[s],
+                                             line.points[s + 1], &t);
+          if (d < n.distance) n = {l, static_cast<int>(s), t, d};
+        }
+        if (!Compatible(p.type, line.type)) {
+          second.distance = std::min(second.distance, n.distance);
+        } else if (n.distance < best.distance) {
+          second.distance = std::min(second.distance, best.distance);
+          best = n;
+        } else {
+          second.distance = std::min(second.distance, n.distance);
+        }
+      }
+      if (best.line < 0 || best.distance > options.gate_m ||
+          second.distance < options.min_separation_ratio * best.distance ||
+          second.distance < options.gate_m) {
+        continue;
+      }
+      const DatabaseLineEnu& line = database[best.line];
+      const Eigen::Vector3d& a = line.points[best.segment];
+      const Eigen::Vector3d& b = line.points[best.segment + 1];
+      Eigen::Vector3d along(b.x() - a.x(), b.y() - a.y(), 0.0);
+      if (along.norm() < 1e-6) continue;
+      along.normalize();
+      if (has_direction && std::abs(direction.dot(along.head<2>())) <
+                               std::cos(options.max_angle_rad)) {
+        continue;
+      }
+      LinePointMatch m;
+      m.point = static_cast<int>(i);
+      m.db_line = best.line;
+      m.db_point_enu = a + best.t * (b - a);
+      m.along_enu = along;
+      m.across_enu = Eigen::Vector3d(-along.y(), along.x(), 0.0);
+      m.distance_m = (p.p_enu - m.db_point_enu).dot(m.across_enu);
+      m.height_m = p.p_enu.z() - m.db_point_enu.z();
+      if (std::abs(m.height_m) > options.max_height_m) continue;
+      matches.push_back(m);
+      ++votes[best.line];
+    }
+    // One database line for the whole reconstructed line.
+    if (votes.size() == 1 &&
+        matches.size() >= options.min_matched_share * (end - begin)) {
+      out.insert(out.end(), matches.begin(), matches.end());
+    }
+    begin = end;
+  }
+  return out;
+}
+
+}  // namespace zebrageo

@@ -1,0 +1,84 @@
+// Road lines to database lines (issue 9, step 2).
+//
+// A reconstructed line point, put in ENU with a trajectory (the GNSS/INS
+// one, or better the one already corrected by the zebra crossings), is
+// matched to the nearest database line of a compatible type (lane_solid and
+// lane_dashed are interchangeable: a dash cut by the image border looks
+// solid; stop lines only to stop lines) when:
+//   - it lies within gate_m of the line horizontally and max_height_m in
+//     height (the trajectory's remaining error);
+//   - the next candidate line is at least min_separation_ratio times
+//     farther (lane lines are 1.5 to 4 m apart: a drift of half the spacing
+//     would match the neighbour, so an ambiguous point is left out);
+//   - the reconstructed line runs along the database segment (angle below
+//     max_angle_rad).
+// All points of one reconstructed line must agree on the database line;
+// lines whose points split between two database lines are dropped.
+//
+// A line constrains only across itself: each match says so, with the
+// horizontal unit normal of the database segment (across) and up (height);
+// the direction along the line is free.
+#ifndef ZEBRAGEO_REGISTRATION_LINE_MATCHER_H_
+#define ZEBRAGEO_REGISTRATION_LINE_MATCHER_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "survey/geodesy.h"
+#include "survey/roadmarks.h"
+
+namespace zebrageo {
+
+struct LineMatchOptions {
+  double gate_m = 0.6;
+  double max_height_m = 0.5;
+  double min_separation_ratio = 2.5;
+  double max_angle_rad = 0.2;
+  // A reconstructed line is kept when at least this share of its points
+  // match, all to the same database line.
+  double min_matched_share = 0.5;
+
+  std::string Check() const;
+};
+
+// A database line in the working frame.
+struct DatabaseLineEnu {
+  std::string id;
+  std::string type;
+  std::vector<Eigen::Vector3d> points;
+  double sigma_xy_m = 0.0;
+  double sigma_z_m = 0.0;
+};
+
+std::vector<DatabaseLineEnu> DatabaseLinesEnu(const RoadmarkDatabase& database,
+                                              const LocalFrame& frame);
+
+// One reconstructed line point in ENU.
+struct LinePointEnu {
+  int64_t line_id = 0;  // points of one line share it, consecutive
+  std::string type;     // lane_solid, lane_dashed, stop_line
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();
+};
+
+struct LinePointMatch {
+  int point = 0;    // index into the points
+  int db_line = 0;  // index into the database lines
+  // The matched database segment's point nearest (horizontally) to the
+  // reconstructed point, and the directions the match constrains.
+  Eigen::Vector3d db_point_enu = Eigen::Vector3d::Zero();
+  Eigen::Vector3d across_enu = Eigen::Vector3d::Zero();  // horizontal unit
+  Eigen::Vector3d along_enu = Eigen::Vector3d::Zero();   // not constrained
+  double distance_m = 0.0;  // horizontal, signed along across_enu
+  double height_m = 0.0;    // point minus database
+};
+
+std::vector<LinePointMatch> MatchLinePoints(
+    const std::vector<LinePointEnu>& points,
+    const std::vector<DatabaseLineEnu>& database,
+    const LineMatchOptions& options);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_REGISTRATION_LINE_MATCHER_H_
