@@ -9,6 +9,16 @@
 //
 // Targets (issue 6): load (GeoJSON parse) + index under 2 s, one candidate
 // query under 50 microseconds.
+//
+// Measured 2026-11-23 on the 2-core development machine while other builds
+// ran (load average 6-17, so wall time is up to 2-9x CPU time), medians of
+// 3 repetitions, 101,715 bands (46 MB of GeoJSON):
+//   LoadAndIndex100kBands  0.35-0.45 s CPU, 0.65-0.92 s wall at load 6-10
+//                          (3.2 s wall at load 17); was 1.9 s CPU, 2.2-2.9 s
+//                          wall with nlohmann::json's DOM
+//   ReadRoadmarks100kBands 0.29-0.36 s CPU
+//   Index100kBands         0.06-0.08 s CPU
+//   CandidateQuery/20      0.4-0.7 us CPU (12.7 bands per query)
 #include <benchmark/benchmark.h>
 
 #include <cmath>

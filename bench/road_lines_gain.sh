@@ -19,11 +19,11 @@ mkdir -p "$work"
 for preset in "${presets[@]}"; do
   survey="$work/$preset"
   [ -d "$survey" ] || "$build/tools/zebrageo" simulate --preset "$preset" --seed 1 -o "$survey"
-  "$build/tools/zebrageo" run "$survey" -o "$work/$preset-lines" --log-level warning
+  "$build/tools/zebrageo" --log-level warning run "$survey" -o "$work/$preset-lines"
   rm -rf "$work/$preset-zebra"
   mkdir -p "$work/$preset-zebra"
   cp "$work/$preset-lines"/{reconstructed_bands.csv,reconstructed_lines.csv,matches.csv,crossing_decisions.csv} "$work/$preset-zebra/"
-  "$build/tools/zebrageo" adjust "$survey" -o "$work/$preset-zebra" --no-lines --log-level warning
+  "$build/tools/zebrageo" --log-level warning adjust "$survey" -o "$work/$preset-zebra" --no-lines
   echo "== $preset"
   /usr/bin/python3 "$score" lines "$survey" "$work/$preset-zebra" "$work/$preset-lines" || true
   /usr/bin/python3 "$score" poses "$survey" "$work/$preset-zebra" || true

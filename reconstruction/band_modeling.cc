@@ -541,6 +541,9 @@ std::string BandOptions::Check() const {
   } else if (!(max_transversal_run_on > 0.0)) {
     error << "max_transversal_run_on = " << max_transversal_run_on
           << ": must be > 0";
+  } else if (!(max_inferred_range_m > 0.0)) {
+    error << "max_inferred_range_m = " << max_inferred_range_m
+          << ": must be > 0";
   } else if (!(hidden_end_max_rms_m > 0.0)) {
     error << "hidden_end_max_rms_m = " << hidden_end_max_rms_m
           << ": must be > 0";
@@ -1294,8 +1297,15 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     const Eigen::Vector3d band_middle =
         0.25 * (band.vertices_body[0] + band.vertices_body[1] +
                 band.vertices_body[2] + band.vertices_body[3]);
-    if ((band_middle - rectification.left_centre_body()).norm() >
-        options.max_band_range_m) {
+    const double range =
+        (band_middle - rectification.left_centre_body()).norm();
+    if (range > options.max_band_range_m) return BandOutcome::kRejected;
+    // An inferred side or end is extrapolated: far away, its error grows
+    // past what a control point may carry (a closer exposure sees it).
+    const bool extrapolated = pairs[i].inferred >= 0 ||
+                              known[0].line != nullptr ||
+                              known[1].line != nullptr;
+    if (extrapolated && range > options.max_inferred_range_m) {
       return BandOutcome::kRejected;
     }
     if (disagreement > options.max_stereo_disagreement_m) {

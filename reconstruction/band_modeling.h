@@ -88,6 +88,9 @@ struct BandOptions {
   double completion_tolerance_m = 0.04;
   double completion_min_sigma_m = 0.01;
   double inferred_score_factor = 0.5;
+  // Bands with an inferred side or end (below) farther than this from the
+  // left camera are not reported: the extrapolation error grows with range.
+  double max_inferred_range_m = 13.0;
   // Hidden band ends: when no transversal side is found at one end of a
   // band, the line through that end's vertices of the crossing's fully
   // seen bands (at least completion_min_bands, residual rms at most
