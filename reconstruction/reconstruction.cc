@@ -20,6 +20,7 @@
 
 #include "survey/image_io.h"
 #include "survey/input_error.h"
+#include "survey/threads.h"
 
 namespace zebrageo {
 namespace {
@@ -28,14 +29,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// CPU time of the calling thread: step timings stay per core when other
-// threads (or processes) compete for the cores.
-double ThreadCpuSeconds() {
-  timespec now;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return now.tv_sec + 1e-9 * now.tv_nsec;
 }
 
 double Median(std::vector<double> values) {
@@ -460,23 +453,6 @@ ExposureResult ProcessExposure(
     result.timings.Add(result.pairs[p].timings);
   }
   return result;
-}
-
-// Runs `work(k)` for k in [0, count) on `threads` threads.
-void ParallelFor(int count, int threads, const std::function<void(int)>& work) {
-  threads = std::max(1, std::min(threads, count));
-  if (threads == 1) {
-    for (int k = 0; k < count; ++k) work(k);
-    return;
-  }
-  std::atomic<int> next{0};
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&] {
-      for (int k = next++; k < count; k = next++) work(k);
-    });
-  }
-  for (std::thread& thread : pool) thread.join();
 }
 
 }  // namespace

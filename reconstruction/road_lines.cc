@@ -15,16 +15,10 @@
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/image_io.h"
+#include "survey/threads.h"
 
 namespace zebrageo {
 namespace {
-
-// CPU time of the calling thread (see reconstruction.cc).
-double ThreadCpuSeconds() {
-  timespec now;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return now.tv_sec + 1e-9 * now.tv_nsec;
-}
 
 bool IsSet(const cv::Mat& mask, int x, int y) {
   return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows &&
@@ -93,22 +87,6 @@ double PolylineLength(const std::vector<Eigen::Vector3d>& points) {
     length += (points[i] - points[i - 1]).norm();
   }
   return length;
-}
-
-void ParallelFor(int count, int threads, const std::function<void(int)>& work) {
-  threads = std::max(1, std::min(threads, count));
-  if (threads == 1) {
-    for (int k = 0; k < count; ++k) work(k);
-    return;
-  }
-  std::atomic<int> next{0};
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&] {
-      for (int k = next++; k < count; k = next++) work(k);
-    });
-  }
-  for (std::thread& thread : pool) thread.join();
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "survey/threads.h"
 #include "tools/simulator/noise.h"
 
 namespace zebrageo::sim {
@@ -53,12 +54,6 @@ constexpr double kFogDistanceM = 700.0;
 inline double PseudoAngle(double x, double y) {
   const double p = x / (std::abs(x) + std::abs(y) + 1e-300);
   return y < 0.0 ? 3.0 + p : 1.0 - p;
-}
-
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
 // Multi-scale value noise of asphalt, octaves finer than ~2 footprints
