@@ -68,11 +68,17 @@ nlohmann::json SummaryJson(const AdjustmentData& data,
                          {"vertical", s.control_rmse_vertical_m}};
   // Check points are held out: their RMSE is the honest accuracy figure. It
   // includes the database's own error (its sigma and per-crossing offset).
-  j["check_rmse_m"] = {{"horizontal", s.check_rmse_horizontal_m},
-                       {"vertical", s.check_rmse_vertical_m},
-                       {"vertices", s.num_check_points},
-                       {"crossings", s.num_check_crossings},
-                       {"held_out_then_control", s.check_points_in_final}};
+  // No check point evaluated: null, so no one reads a perfect 0.
+  const bool checked = s.num_check_points_evaluated > 0;
+  j["check_rmse_m"] = {
+      {"horizontal", checked ? nlohmann::json(s.check_rmse_horizontal_m)
+                             : nlohmann::json(nullptr)},
+      {"vertical", checked ? nlohmann::json(s.check_rmse_vertical_m)
+                           : nlohmann::json(nullptr)},
+      {"vertices", s.num_check_points},
+      {"evaluated_vertices", s.num_check_points_evaluated},
+      {"crossings", s.num_check_crossings},
+      {"held_out_then_control", s.check_points_in_final}};
   j["correction_m"] = {{"max_horizontal", s.max_correction_horizontal_m},
                        {"max_vertical", s.max_correction_vertical_m},
                        {"rms_horizontal", s.rms_correction_horizontal_m}};

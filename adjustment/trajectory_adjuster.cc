@@ -772,7 +772,7 @@ std::string AdjustmentSummary::BriefReport() const {
       << num_rejected_points << " rejected, " << num_tie_tracks
       << " tie tracks; sigma0 " << sigma0 << ", " << iterations
       << " iterations in " << solves << " solves, " << time_in_seconds << " s";
-  if (num_check_points > 0) {
+  if (num_check_points_evaluated > 0) {
     out << "; check RMSE H " << 100.0 * check_rmse_horizontal_m << " cm, V "
         << 100.0 * check_rmse_vertical_m << " cm";
   }
@@ -1365,6 +1365,7 @@ AdjustmentResult AdjustTrajectory(
   summary.control_rmse_vertical_m = Rms(control_v);
   summary.check_rmse_horizontal_m = Rms(check_h);
   summary.check_rmse_vertical_m = Rms(check_v);
+  summary.num_check_points_evaluated = static_cast<int>(check_h.size());
   if (summary.num_rejected_points > 0) {
     std::set<std::string> names;
     for (const ControlPoint& p : state.points) {

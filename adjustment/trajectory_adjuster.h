@@ -234,8 +234,11 @@ struct AdjustmentSummary {
   // Adjusted (control) or image-only (check) minus database, metres.
   double control_rmse_horizontal_m = 0.0;
   double control_rmse_vertical_m = 0.0;
+  // Over the check points that could be triangulated (their count): 0
+  // when there are none, which the reports write as null, not as 0.
   double check_rmse_horizontal_m = 0.0;
   double check_rmse_vertical_m = 0.0;
+  int num_check_points_evaluated = 0;
   // Size of the correction applied to the trajectory samples.
   // GNSS/INS position sigma of the prior (estimated or as configured).
   double gnss_sigma_horizontal_m = 0.0;

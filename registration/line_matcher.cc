@@ -145,4 +145,121 @@ std::vector<LinePointMatch> MatchLinePoints(
   return out;
 }
 
+std::string LineConsistencyOptions::Check() const {
+  std::ostringstream e;
+  if (!(window_s > 0.0) || !(max_offset_m > 0.0)) {
+    e << "window_s and max_offset_m must be positive";
+  } else if (min_points < 1) {
+    e << "min_points must be at least 1";
+  } else if (!(min_parallel_cos > 0.0 && min_parallel_cos < 1.0)) {
+    e << "min_parallel_cos must be in (0, 1)";
+  }
+  const std::string error = e.str();
+  return error.empty() ? error : "line consistency options: " + error;
+}
+
+namespace {
+
+double MedianOf(std::vector<double>* values) {
+  auto mid = values->begin() + values->size() / 2;
+  std::nth_element(values->begin(), mid, values->end());
+  return *mid;
+}
+
+// The matches of one database line within one second: their median
+// distance across the line, the line's normal there, and how many.
+struct LineSecond {
+  int db_line = 0;
+  int64_t second = 0;
+  double distance_m = 0.0;
+  Eigen::Vector2d across = Eigen::Vector2d::Zero();
+  int points = 0;
+};
+
+std::vector<LineSecond> LineSeconds(const std::vector<LinePointMatch>& matches,
+                                    const std::vector<double>& point_time) {
+  std::map<std::pair<int, int64_t>, std::vector<int>> groups;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    const double t = point_time.at(matches[i].point);
+    groups[{matches[i].db_line, static_cast<int64_t>(std::floor(t))}].push_back(
+        static_cast<int>(i));
+  }
+  std::vector<LineSecond> seconds;
+  std::vector<double> distances;
+  for (const auto& [key, members] : groups) {
+    distances.clear();
+    for (int i : members) distances.push_back(matches[i].distance_m);
+    LineSecond s;
+    s.db_line = key.first;
+    s.second = key.second;
+    s.distance_m = MedianOf(&distances);
+    s.across = matches[members.front()].across_enu.head<2>();
+    s.points = static_cast<int>(members.size());
+    seconds.push_back(s);
+  }
+  return seconds;
+}
+
+}  // namespace
+
+std::vector<RejectedLine> RejectInconsistentLines(
+    const std::vector<LinePointMatch>& matches,
+    const std::vector<double>& point_time,
+    const LineConsistencyOptions& options, std::vector<LinePointMatch>* kept) {
+  // Per line and second first, so that each other line counts once in a
+  // reference however many points it has (a long solid line would
+  // otherwise outvote every dash of the centre line).
+  std::vector<LineSecond> seconds = LineSeconds(matches, point_time);
+  std::stable_sort(seconds.begin(), seconds.end(),
+                   [](const LineSecond& a, const LineSecond& b) {
+                     return a.second < b.second;
+                   });
+  const int64_t window = static_cast<int64_t>(std::ceil(options.window_s));
+  std::map<int, std::vector<double>> offsets_of_line;
+  std::map<int, int> points_of_line;
+  std::map<int, std::vector<double>> other_lines;
+  std::vector<double> references;
+  for (const LineSecond& s : seconds) {
+    other_lines.clear();
+    const auto first = std::lower_bound(
+        seconds.begin(), seconds.end(), s.second - window,
+        [](const LineSecond& a, int64_t t) { return a.second < t; });
+    for (auto o = first; o != seconds.end() && o->second <= s.second + window;
+         ++o) {
+      if (o->db_line == s.db_line) continue;
+      const double cos = o->across.dot(s.across);
+      if (std::abs(cos) < options.min_parallel_cos) continue;
+      // The other line's displacement, along this line's normal.
+      other_lines[o->db_line].push_back(o->distance_m * cos);
+    }
+    if (other_lines.empty()) continue;
+    references.clear();
+    for (auto& [line, values] : other_lines) {
+      references.push_back(MedianOf(&values));
+    }
+    offsets_of_line[s.db_line].push_back(s.distance_m - MedianOf(&references));
+    points_of_line[s.db_line] += s.points;
+  }
+  std::vector<RejectedLine> rejected;
+  for (auto& [line, offsets] : offsets_of_line) {
+    if (points_of_line[line] < options.min_points) continue;
+    const double offset = MedianOf(&offsets);
+    if (std::abs(offset) > options.max_offset_m) {
+      rejected.push_back({line, points_of_line[line], offset});
+    }
+  }
+  std::sort(rejected.begin(), rejected.end(),
+            [](const RejectedLine& a, const RejectedLine& b) {
+              return std::abs(a.offset_m) > std::abs(b.offset_m);
+            });
+  kept->clear();
+  for (const LinePointMatch& m : matches) {
+    const bool bad = std::any_of(
+        rejected.begin(), rejected.end(),
+        [&](const RejectedLine& r) { return r.db_line == m.db_line; });
+    if (!bad) kept->push_back(m);
+  }
+  return rejected;
+}
+
 }  // namespace zebrageo

@@ -79,6 +79,40 @@ std::vector<LinePointMatch> MatchLinePoints(
     const std::vector<DatabaseLineEnu>& database,
     const LineMatchOptions& options);
 
+// Stale database lines. A line repainted since the database was made (or a
+// database line that was never this mark) still lies within the matching
+// gate when it moved by a few decimetres, and would pull the trajectory by
+// as much. The trajectory's own remaining error is common to every line
+// seen at the same time, so each database line is compared with the others:
+// a point's offset is its distance across the line minus the median
+// distance, along the same direction, of the points of the other (parallel)
+// lines matched within window_s of it. A database line whose median offset
+// exceeds max_offset_m, over at least min_points points, is rejected. A line
+// seen alone cannot be checked and is kept (the adjustment's robust loss
+// remains).
+struct LineConsistencyOptions {
+  double window_s = 10.0;
+  double max_offset_m = 0.15;
+  int min_points = 5;
+  // Other lines count as parallel when |cos| of their normals exceeds this.
+  double min_parallel_cos = 0.9;
+
+  std::string Check() const;
+};
+
+struct RejectedLine {
+  int db_line = 0;
+  int points = 0;         // its matched points with a reference
+  double offset_m = 0.0;  // median offset from the other lines, signed
+};
+
+// Splits `matches` (of points at `point_time[m.point]`) into the kept ones
+// and the database lines rejected as inconsistent, largest offset first.
+std::vector<RejectedLine> RejectInconsistentLines(
+    const std::vector<LinePointMatch>& matches,
+    const std::vector<double>& point_time,
+    const LineConsistencyOptions& options, std::vector<LinePointMatch>* kept);
+
 }  // namespace zebrageo
 
 #endif  // ZEBRAGEO_REGISTRATION_LINE_MATCHER_H_

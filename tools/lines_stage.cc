@@ -5,9 +5,12 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -43,6 +46,44 @@ bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
   pose->p_enu = (1.0 - u) * a.p_enu + u * b.p_enu;
   pose->q_enu_body = a.q_enu_body.slerp(u, b.q_enu_body);
   return true;
+}
+
+// line_control.json: what the road lines controlled, per stretch of
+// stretch_s seconds from the first exposure (tools/report reads it).
+void WriteLineControlSummary(const std::map<int, std::array<int, 3>>& stretches,
+                             double stretch_s, double start_time,
+                             size_t reconstructed_points, size_t matched_points,
+                             size_t used_points, const nlohmann::json& rejected,
+                             const std::string& results_folder) {
+  nlohmann::json j;
+  j["stretch_s"] = stretch_s;
+  j["reconstructed_points"] = reconstructed_points;
+  j["matched_points"] = matched_points;
+  j["used_points"] = used_points;
+  j["rejected_lines"] = rejected;
+  j["note"] =
+      "a road line constrains the position across itself and the height, "
+      "never along itself: lane lines control cross-track and height, "
+      "along-track only where stop lines matched";
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [k, s] : stretches) {
+    nlohmann::json controlled = nlohmann::json::array();
+    if (s[0] > 0) controlled.push_back("cross-track");
+    if (s[1] > 0) controlled.push_back("height");
+    if (s[2] > 0) controlled.push_back("along-track");
+    list.push_back({{"t0_s", k * stretch_s},
+                    {"t1_s", (k + 1) * stretch_s},
+                    {"time0", start_time + k * stretch_s},
+                    {"cross_track_points", s[0]},
+                    {"height_points", s[1]},
+                    {"along_track_points", s[2]},
+                    {"controlled", controlled}});
+  }
+  j["stretches"] = list;
+  AtomicFile file(
+      (std::filesystem::path(results_folder) / kLineControlFile).string());
+  file.stream() << j.dump(2) << "\n";
+  file.Commit();
 }
 
 }  // namespace
@@ -106,8 +147,29 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   }
   const std::vector<DatabaseLineEnu> database =
       DatabaseLinesEnu(data.roadmarks, data.frame);
-  const std::vector<LinePointMatch> matches =
+  const std::vector<LinePointMatch> all_matches =
       MatchLinePoints(enu, database, LineMatchOptions());
+  std::vector<double> point_time(enu.size());
+  for (size_t i = 0; i < enu.size(); ++i) {
+    point_time[i] = exposure_time[points[source[i]].exposure_id];
+  }
+  std::vector<LinePointMatch> matches;
+  const std::vector<RejectedLine> rejected = RejectInconsistentLines(
+      all_matches, point_time, LineConsistencyOptions(), &matches);
+  nlohmann::json rejected_json = nlohmann::json::array();
+  for (const RejectedLine& r : rejected) {
+    const DatabaseLineEnu& line = database[r.db_line];
+    std::ostringstream w;
+    w << "road-mark database line " << line.id << " (" << line.type << ") lies "
+      << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
+      << " m across from where the other lines seen with it put it ("
+      << r.points << " points): repainted or stale, not used as control";
+    LOG(WARNING) << w.str();
+    rejected_json.push_back({{"db_line", line.id},
+                             {"type", line.type},
+                             {"points", r.points},
+                             {"offset_m", r.offset_m}});
+  }
 
   AtomicFile file(
       (std::filesystem::path(results_folder) / "line_matches.csv").string());
@@ -118,6 +180,9 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
       "never along the line");
   // Per 30 s stretch: matches, and the directions controlled.
   const double stretch_s = 30.0;
+  const double start_time = data.exposures.exposures.empty()
+                                ? 0.0
+                                : data.exposures.exposures.front().time;
   std::map<int, std::array<int, 3>> stretches;  // cross-track, height, along
   csv.Header({"exposure_id", "line_id", "point", "type", "db_line", "across_e",
               "across_n", "distance_m", "height_m", "constrains"});
@@ -138,7 +203,8 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     // Across the line is cross-track when the line runs with the vehicle.
     const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
     const bool cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
-    auto& s = stretches[static_cast<int>(std::floor(c.time / stretch_s))];
+    auto& s = stretches[static_cast<int>(
+        std::floor((c.time - start_time) / stretch_s))];
     s[cross_track ? 0 : 2] += 1;
     s[1] += 1;
     csv.Add(p.exposure_id)
@@ -154,12 +220,15 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     csv.EndRow();
   }
   file.Commit();
+  WriteLineControlSummary(stretches, stretch_s, start_time, points.size(),
+                          all_matches.size(), matches.size(), rejected_json,
+                          results_folder);
   std::ostringstream report;
   report << "road lines: " << matches.size() << " of " << points.size()
          << " line points matched to database lines; per " << stretch_s
          << " s stretch (cross-track/height/along-track points):";
   for (const auto& [k, s] : stretches) {
-    report << " [" << k * stretch_s << " s: " << s[0] << "/" << s[1] << "/"
+    report << " [+" << k * stretch_s << " s: " << s[0] << "/" << s[1] << "/"
            << s[2] << "]";
   }
   LOG(INFO) << report.str();

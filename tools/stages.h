@@ -48,9 +48,15 @@ std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
                                         const AdjustmentOptions& options,
                                         bool tie_points, bool lines = true);
 
+// What the road lines controlled, per stretch, and the database lines
+// rejected as stale (written by MatchLinesForAdjustment, read by the report).
+inline constexpr char kLineControlFile[] = "line_control.json";
+
 // The road-line points of results_folder/reconstructed_lines.csv matched to
-// the database lines with the trajectory of `zebra_result`, as control for
-// the adjustment; writes line_matches.csv. Empty without lines.
+// the database lines with the trajectory of `zebra_result`, database lines
+// that disagree with the others rejected (warnings), as control for the
+// adjustment; writes line_matches.csv and line_control.json. Empty without
+// lines.
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
     const AdjustmentResult& zebra_result, const std::string& results_folder,

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace zebrageo {
@@ -91,6 +92,74 @@ TEST(MatchLinePoints, TypesAndDirectionMustAgree) {
   ASSERT_EQ(matches.size(), stop.size());
   EXPECT_NEAR(std::abs(matches[0].across_enu.x()), 1.0, 1e-9);
   EXPECT_NEAR(std::abs(matches[0].distance_m), 0.2, 1e-9);
+}
+
+// Both edge lines and the centre line seen from 0 to 100 m at 10 m/s,
+// with a common trajectory error `drift`; the right edge line painted
+// `moved_m` to the left of where the database has it.
+struct SeenStreet {
+  std::vector<LinePointEnu> points;
+  std::vector<double> time;  // per point
+};
+SeenStreet SeeStreet(const Eigen::Vector3d& drift, double moved_m) {
+  SeenStreet seen;
+  auto add = [&](const std::vector<LinePointEnu>& line) {
+    for (const LinePointEnu& p : line) {
+      seen.points.push_back(p);
+      seen.time.push_back(p.p_enu.x() / 10.0);
+    }
+  };
+  add(Seen(1, "lane_solid", -3.2 + moved_m, 1, 99, drift));
+  add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
+  for (double x = 0; x < 100; x += 9) {
+    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5, x + 2.5,
+             drift));
+  }
+  return seen;
+}
+
+TEST(RejectInconsistentLines, RejectsALineRepaintedSinceTheDatabase) {
+  const auto db = Street();
+  const SeenStreet seen = SeeStreet(Eigen::Vector3d(0.4, -0.25, 0.1), 0.3);
+  const auto matches = MatchLinePoints(seen.points, db, LineMatchOptions());
+  // Within the gate, the moved line matches its old database position.
+  const auto on_moved =
+      std::count_if(matches.begin(), matches.end(),
+                    [](const LinePointMatch& m) { return m.db_line == 0; });
+  ASSERT_GE(on_moved, 95);
+  std::vector<LinePointMatch> kept;
+  const auto rejected = RejectInconsistentLines(
+      matches, seen.time, LineConsistencyOptions(), &kept);
+  ASSERT_EQ(rejected.size(), 1u);
+  EXPECT_EQ(rejected[0].db_line, 0);
+  // The offset is the repaint, not the trajectory's error (-0.25 across).
+  EXPECT_NEAR(std::abs(rejected[0].offset_m), 0.3, 0.01);
+  EXPECT_GT(rejected[0].points, 50);
+  for (const LinePointMatch& m : kept) EXPECT_NE(m.db_line, 0);
+  EXPECT_EQ(kept.size(), matches.size() - on_moved);
+}
+
+TEST(RejectInconsistentLines, KeepsLinesThatAgreeOrCannotBeChecked) {
+  const auto db = Street();
+  // A large common error is the trajectory's, not the lines'.
+  const SeenStreet seen = SeeStreet(Eigen::Vector3d(0.4, -0.45, 0.1), 0.0);
+  const auto matches = MatchLinePoints(seen.points, db, LineMatchOptions());
+  std::vector<LinePointMatch> kept;
+  EXPECT_TRUE(RejectInconsistentLines(matches, seen.time,
+                                      LineConsistencyOptions(), &kept)
+                  .empty());
+  EXPECT_EQ(kept.size(), matches.size());
+  // One line alone, even off by 0.3 m: nothing to compare with, kept.
+  const auto alone =
+      Seen(1, "lane_solid", -2.9, 1, 99, Eigen::Vector3d::Zero());
+  std::vector<double> time;
+  for (const auto& p : alone) time.push_back(p.p_enu.x() / 10.0);
+  const auto alone_matches = MatchLinePoints(alone, db, LineMatchOptions());
+  ASSERT_FALSE(alone_matches.empty());
+  EXPECT_TRUE(RejectInconsistentLines(alone_matches, time,
+                                      LineConsistencyOptions(), &kept)
+                  .empty());
+  EXPECT_EQ(kept.size(), alone_matches.size());
 }
 
 }  // namespace

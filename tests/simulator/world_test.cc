@@ -255,5 +255,90 @@ TEST(World, DatabaseIsTruthPlusOffsetAndNoise) {
   EXPECT_TRUE(types.count("lane_dashed"));
 }
 
+// Road coordinates (s, l) of a point near the road (guess from the
+// nearest centreline sample).
+Eigen::Vector2d RoadCoordinatesOf(const Road& road, const Eigen::Vector3d& p) {
+  double best_s = 0.0, best = 1e18;
+  for (double s = 0.0; s <= road.length_m(); s += 2.0) {
+    const double d = (road.SurfacePoint(s, 0.0) - p).head<2>().squaredNorm();
+    if (d < best) best = d, best_s = s;
+  }
+  double s = 0.0, l = 0.0;
+  EXPECT_TRUE(road.ToRoadCoordinates(p.head<2>(), best_s, &s, &l));
+  return {s, l};
+}
+
+TEST(World, DatabaseLinesHaveGapsMovedStretchesAndRemovedStopLines) {
+  SimulationOptions options = WorldOptions();
+  options.database_sigma_xy_m = 0.0;
+  options.database_sigma_z_m = 0.0;
+  options.stop_line_probability = 0.3;
+  options.database_line_gap_share = 0.15;
+  options.num_moved_lines = 2;
+  options.num_removed_stop_lines = 1;
+  const World world = BuildWorld(options);
+  const LocalFrame frame(Geodetic{options.origin_lat_deg,
+                                  options.origin_lon_deg, options.origin_h_m});
+  const RoadmarkDatabase db = MakeDatabaseRoadmarks(world, options, frame);
+  std::map<std::string, int> kinds;
+  for (const DatabaseLineFault& f : world.database_line_faults) ++kinds[f.kind];
+  EXPECT_GE(kinds["gap"], 3);  // every lane line has gaps
+  EXPECT_EQ(kinds["moved"], 2);
+  EXPECT_EQ(kinds["removed"], 1);
+  // Where the database says a lane line is, by road coordinates.
+  int inside_gap = 0, on_moved = 0, on_street = 0;
+  for (const RoadmarkLine& line : db.lines) {
+    if (line.type == "stop_line") continue;
+    for (const Geodetic& g : line.points) {
+      const Eigen::Vector2d sl =
+          RoadCoordinatesOf(world.road, frame.EnuFromGeodetic(g));
+      const DatabaseLineFault* moved = nullptr;
+      bool in_gap = false;
+      for (const DatabaseLineFault& f : world.database_line_faults) {
+        // Fault intervals of this line position, away from their ends.
+        const bool here = sl.x() > f.s0 + 0.01 && sl.x() < f.s1 - 0.01;
+        if (f.kind == "gap" && here && std::abs(sl.y() - f.l_m) < 0.01) {
+          in_gap = true;
+        }
+        const bool near = sl.x() > f.s0 - 0.01 && sl.x() < f.s1 + 0.01;
+        if (f.kind == "moved" && near &&
+            std::abs(sl.y() - f.l_m - f.shift_m) < 0.01) {
+          moved = &f;
+        }
+      }
+      inside_gap += in_gap ? 1 : 0;
+      if (moved != nullptr) {
+        ++on_moved;
+        EXPECT_GE(std::abs(moved->shift_m), 0.25);
+        EXPECT_LE(std::abs(moved->shift_m), 0.45);
+      } else {
+        // Anywhere else the database line is where the street has it.
+        bool on_a_street_line = false;
+        for (const LinePiece& piece : world.lines) {
+          on_a_street_line |= std::abs(sl.y() - piece.l_m) < 0.01 &&
+                              sl.x() > piece.s0 - 0.01 &&
+                              sl.x() < piece.s1 + 0.01;
+        }
+        EXPECT_TRUE(on_a_street_line) << "s " << sl.x() << " l " << sl.y();
+        ++on_street;
+      }
+    }
+  }
+  EXPECT_EQ(inside_gap, 0);
+  EXPECT_GT(on_moved, 10);
+  EXPECT_GT(on_street, 100);
+  // The removed stop line is in the database, at a crossing that has none.
+  for (const DatabaseLineFault& f : world.database_line_faults) {
+    if (f.kind != "removed") continue;
+    const Crossing& c = world.crossings[f.crossing];
+    EXPECT_FALSE(c.stop_line);
+    int found = 0;
+    for (const RoadmarkLine& line : db.lines) {
+      found += line.type == "stop_line" && line.id == "stop-" + c.id;
+    }
+    EXPECT_EQ(found, 1);
+  }
+}
+
 }  // namespace
 }  // namespace zebrageo::sim

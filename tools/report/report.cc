@@ -41,6 +41,7 @@ struct ReportData {
   json match_evidence;  // may be null
   json adjustment;      // may be null
   json reconstruction;  // may be null
+  json line_control;    // may be null (no road lines used)
   int reconstructed_bands = 0;
   int matched_vertices = 0;
   std::vector<std::string> missing_files;
@@ -163,6 +164,12 @@ ReportData Collect(const ReportInputs& inputs) {
   if (Exists(folder + "reconstruction.json")) {
     data.reconstruction =
         ReadJsonFile(folder + "reconstruction.json", "reconstruction.json");
+  }
+  // Written by the adjustment only when road lines were used: not missing
+  // otherwise.
+  if (Exists(folder + "line_control.json")) {
+    data.line_control =
+        ReadJsonFile(folder + "line_control.json", "line_control.json");
   }
   return data;
 }
@@ -359,6 +366,7 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
           ? data.match_evidence["faults"]
           : json::array();
   report["uncontrolled_stretches"] = UncontrolledStretches(data, options);
+  if (data.line_control.is_object()) report["road_lines"] = data.line_control;
 
   json timings = json::object();
   double total = 0.0;
@@ -405,6 +413,20 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
       data.adjustment["sigma0"].get<double>() > options.max_sigma0) {
     warnings.push_back("high sigma0 (" + data.adjustment["sigma0"].dump() +
                        "): observations fit worse than their stated weights");
+  }
+  if (report.contains("road_lines")) {
+    for (const json& line :
+         report["road_lines"].value("rejected_lines", json::array())) {
+      std::ostringstream text;
+      text.precision(2);
+      text << std::fixed << "database: road line "
+           << line.value("db_line", std::string()) << " ("
+           << line.value("type", std::string()) << ") lies "
+           << std::abs(line.value("offset_m", 0.0))
+           << " m across from where the other lines put it: repainted or "
+              "stale, not used as control";
+      warnings.push_back(text.str());
+    }
   }
   for (const json& fault : report["database_faults"]) {
     if (fault.contains("description")) {
@@ -606,6 +628,62 @@ std::string ResidualPlots(const ReportData& data) {
 // Before/after figure of the adjustment: per observation type, the RMS of
 // the residuals before (grey) and after (blue) as bars scaled to the larger
 // of the two (the types differ by orders of magnitude and in units).
+// Road-line control per stretch: how many matched line points constrained
+// each direction (lane lines: cross-track and height; along-track only
+// stop lines), against time, and the stretches as a table.
+std::string RoadLineSection(const json& road_lines, const ReportData& data) {
+  if (!road_lines.is_object()) {
+    return "<p class='none'>road lines not used (run without --no-lines and "
+           "with road lines in the database)</p>\n";
+  }
+  const double t0 = data.time_s.empty() ? 0.0 : data.time_s.front();
+  SvgPlot plot("Road-line control per stretch", "time since start (s)",
+               "matched line points");
+  plot.SetNote(road_lines.value("note", std::string()));
+  const char* keys[3] = {"cross_track_points", "height_points",
+                         "along_track_points"};
+  const char* labels[3] = {"cross-track", "height", "along-track"};
+  const char* colours[3] = {"#1f77b4", "#ff7f0e", "#2ca02c"};
+  json rows = json::array();
+  for (int k = 0; k < 3; ++k) {
+    PlotSeries series;
+    series.label = labels[k];
+    series.colour = colours[k];
+    series.markers = true;
+    for (const json& s : road_lines.value("stretches", json::array())) {
+      const double t =
+          s.value("time0", 0.0) - t0 + 0.5 * road_lines.value("stretch_s", 0.0);
+      series.x.push_back(t);
+      series.y.push_back(s.value(keys[k], 0));
+    }
+    plot.AddSeries(std::move(series));
+  }
+  for (const json& s : road_lines.value("stretches", json::array())) {
+    std::string controlled;
+    for (const json& d : s.value("controlled", json::array())) {
+      controlled += (controlled.empty() ? "" : ", ") + d.get<std::string>();
+    }
+    const double start = s.value("time0", 0.0) - t0;
+    rows.push_back({{"from (s)", start},
+                    {"to (s)", start + road_lines.value("stretch_s", 0.0)},
+                    {"cross-track points", s.value(keys[0], 0)},
+                    {"height points", s.value(keys[1], 0)},
+                    {"along-track points", s.value(keys[2], 0)},
+                    {"controlled", controlled}});
+  }
+  std::ostringstream html;
+  html << "<p>" << road_lines.value("used_points", 0) << " of "
+       << road_lines.value("reconstructed_points", 0)
+       << " reconstructed line points used as control ("
+       << road_lines.value("matched_points", 0)
+       << " matched; the rest of the matched ones lie on rejected database "
+          "lines).</p>\n"
+       << plot.Render() << ArrayTable(rows)
+       << "<p>Database lines rejected (repainted or stale):</p>\n"
+       << ArrayTable(road_lines.value("rejected_lines", json::array()));
+  return html.str();
+}
+
 std::string BeforeAfterFigure(const json& adjustment) {
   if (!adjustment.is_object() || !adjustment.contains("rms")) return "";
   constexpr int kRowPx = 44, kLabelPx = 230, kBarPx = 420, kWidthPx = 860;
@@ -716,6 +794,8 @@ std::string RenderHtml(const json& report, const ReportData& data) {
        << ArrayTable(report["database_faults"]);
   html << "<h2>Stretches without control</h2>\n"
        << ArrayTable(report["uncontrolled_stretches"]);
+  html << "<h2>Road lines</h2>\n"
+       << RoadLineSection(report.value("road_lines", json()), data);
   html << "<h2>Counts</h2>\n" << KeyValueTable(report["counts"]);
   html << "<h2>Stage timings</h2>\n" << KeyValueTable(report["timings_s"]);
   if (report.contains("peak_memory_mb")) {

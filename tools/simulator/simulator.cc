@@ -155,6 +155,9 @@ const std::vector<Field>& Fields() {
       ZEBRAGEO_SIM_FIELD(num_missing_bands),
       ZEBRAGEO_SIM_FIELD(num_repainted_crossings),
       ZEBRAGEO_SIM_FIELD(repaint_shift_m),
+      ZEBRAGEO_SIM_FIELD(database_line_gap_share),
+      ZEBRAGEO_SIM_FIELD(num_moved_lines),
+      ZEBRAGEO_SIM_FIELD(num_removed_stop_lines),
   };
   return fields;
 }
@@ -401,6 +404,9 @@ std::string SimulationOptions::Check() const {
   c.Range("num_missing_bands", num_missing_bands, 0, 100000);
   c.Range("num_repainted_crossings", num_repainted_crossings, 0, 100000);
   c.Range("repaint_shift_m", repaint_shift_m, 0.0, 2.0);
+  c.Range("database_line_gap_share", database_line_gap_share, 0.0, 0.9);
+  c.Range("num_moved_lines", num_moved_lines, 0, 100000);
+  c.Range("num_removed_stop_lines", num_removed_stop_lines, 0, 100000);
 
   // Consistency between fields.
   const int faulty =
@@ -702,6 +708,16 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
                                          {"in_db", false},
                                          {"in_street", true}});
     }
+  }
+  faults["database_lines"] = nlohmann::json::array();
+  for (const sim::DatabaseLineFault& f : world.database_line_faults) {
+    nlohmann::json j = {{"kind", f.kind},
+                        {"l_m", f.l_m},
+                        {"s0_m", f.s0},
+                        {"s1_m", f.s1},
+                        {"shift_m", f.shift_m}};
+    if (f.crossing >= 0) j["crossing_id"] = world.crossings[f.crossing].id;
+    faults["database_lines"].push_back(j);
   }
   meta["crossings"] = crossings;
   meta["faults"] = faults;

@@ -244,6 +244,15 @@ struct SimulationOptions {
   int num_missing_bands = 0;
   int num_repainted_crossings = 0;
   double repaint_shift_m = 0.3;
+  // Faults of the database's lines (lane and stop lines): a share of each
+  // lane line's length missing from the database (gaps of 10-30 m); stretches
+  // of 30-60 m of a lane line repainted 0.25-0.45 m across the road since
+  // the database was made (the database holds the old position: inside a
+  // matcher's gate, the dangerous case); stop lines in the database that are
+  // no longer painted (at crossings without a stop line).
+  double database_line_gap_share = 0.1;
+  int num_moved_lines = 1;
+  int num_removed_stop_lines = 1;
 
   // "" when every field is valid, else one "field = value: must be ..."
   // message per problem, joined by "; ".

@@ -242,6 +242,19 @@ void PaintBands(const SimulationOptions& options, World* world) {
   }
 }
 
+// The stop line across the driving lane, 2 m before crossing `ci`.
+StopLine StopLineBefore(const World& world, int ci,
+                        const SimulationOptions& options) {
+  const Crossing& c = world.crossings[ci];
+  StopLine line;
+  line.width_m = 0.3;
+  line.s_m = c.s_min - 2.0 - 0.5 * line.width_m;
+  line.l0 = -0.5 * world.road.width_m() + kEdgeLineInsetM;
+  line.l1 = -0.5 * options.lane_line_width_m - 0.05;
+  line.crossing = ci;
+  return line;
+}
+
 void PaintLines(const SimulationOptions& options, World* world) {
   const Road& road = world->road;
   const double half = 0.5 * road.width_m();
@@ -270,15 +283,65 @@ void PaintLines(const SimulationOptions& options, World* world) {
     }
   }
   for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
+    if (!world->crossings[ci].stop_line) continue;
+    world->stop_lines.push_back(StopLineBefore(*world, ci, options));
+  }
+}
+
+// The lateral positions of the lane lines (edge, centre, edge).
+std::vector<double> LaneLinePositions(const World& world,
+                                      const SimulationOptions& options) {
+  if (!options.lane_lines) return {};
+  const double edge = 0.5 * world.road.width_m() - kEdgeLineInsetM;
+  return {-edge, 0.0, edge};
+}
+
+// Where the database's copy of the road lines differs from the street. Its
+// own generator: the street, and the bands of the database, do not change
+// with the line-fault knobs.
+void PlanDatabaseLineFaults(const SimulationOptions& options, World* world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kDatabaseSeed, 7));
+  const std::vector<double> positions = LaneLinePositions(*world, options);
+  const double a = world->s_drive_start;
+  const double b = world->s_drive_end;
+  for (double l : positions) {
+    // Gaps may overlap: the share is approximate (at most the knob).
+    double missing = options.database_line_gap_share * (b - a);
+    while (missing > 1.0) {
+      const double gap = std::min(missing, Uniform(&rng, 10.0, 30.0));
+      const double s0 = Uniform(&rng, a, std::max(a, b - gap));
+      world->database_line_faults.push_back({"gap", l, s0, s0 + gap});
+      missing -= gap;
+    }
+  }
+  for (int i = 0; i < options.num_moved_lines && !positions.empty(); ++i) {
+    DatabaseLineFault moved;
+    moved.kind = "moved";
+    moved.l_m =
+        positions[UniformInt(&rng, 0, static_cast<int>(positions.size()) - 1)];
+    const double length = Uniform(&rng, 30.0, 60.0);
+    moved.s0 = Uniform(&rng, a, std::max(a, b - length));
+    moved.s1 = moved.s0 + length;
+    moved.shift_m =
+        (Bernoulli(&rng, 0.5) ? 1.0 : -1.0) * Uniform(&rng, 0.25, 0.45);
+    world->database_line_faults.push_back(moved);
+  }
+  std::vector<int> without_stop_line;
+  for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
     const Crossing& c = world->crossings[ci];
-    if (!c.stop_line) continue;
-    StopLine line;
-    line.width_m = 0.3;
-    line.s_m = c.s_min - 2.0 - 0.5 * line.width_m;
-    line.l0 = -half + kEdgeLineInsetM;
-    line.l1 = -0.5 * options.lane_line_width_m - 0.05;
-    line.crossing = ci;
-    world->stop_lines.push_back(line);
+    if (c.in_street && !c.stop_line) without_stop_line.push_back(ci);
+  }
+  std::shuffle(without_stop_line.begin(), without_stop_line.end(), rng);
+  const int removed =
+      std::min<int>(options.num_removed_stop_lines, without_stop_line.size());
+  for (int i = 0; i < removed; ++i) {
+    const StopLine stop = StopLineBefore(*world, without_stop_line[i], options);
+    DatabaseLineFault fault;
+    fault.kind = "removed";
+    fault.l_m = stop.l0;
+    fault.s0 = fault.s1 = stop.s_m;
+    fault.crossing = stop.crossing;
+    world->database_line_faults.push_back(fault);
   }
 }
 
@@ -560,6 +623,7 @@ World BuildWorld(const SimulationOptions& options) {
   PlaceCrossings(options, &world);
   PaintBands(options, &world);
   PaintLines(options, &world);
+  PlanDatabaseLineFaults(options, &world);
   PlaceSmallMarks(options, &world);
   BuildFacades(options, &world);
   ParkVehicles(options, &world);
@@ -601,6 +665,63 @@ std::vector<LineGeometry> LineGeometries(const World& world) {
   for (const StopLine& stop : world.stop_lines) {
     const Road& road = world.road;
     out.push_back({"stop-" + world.crossings[stop.crossing].id,
+                   "stop_line",
+                   {road.SurfacePoint(stop.s_m, stop.l0),
+                    road.SurfacePoint(stop.s_m, stop.l1)}});
+  }
+  return out;
+}
+
+// The database's copy of the lines: the street's, without the gaps, with
+// the moved stretches at their old position, plus the removed stop lines.
+std::vector<LineGeometry> DatabaseLineGeometries(
+    const World& world, const SimulationOptions& options) {
+  const std::vector<LineGeometry> street = LineGeometries(world);
+  std::vector<LineGeometry> out;
+  const Road& road = world.road;
+  for (size_t i = 0; i < world.lines.size(); ++i) {
+    const LinePiece& line = world.lines[i];
+    const double step = line.type == "lane_dashed" ? 1.0 : 2.0;
+    std::vector<std::pair<double, double>> gaps, not_here;
+    std::vector<const DatabaseLineFault*> moved;
+    for (const DatabaseLineFault& f : world.database_line_faults) {
+      if (std::abs(f.l_m - line.l_m) > 1e-6) continue;
+      if (f.kind == "gap") gaps.push_back({f.s0, f.s1});
+      if (f.kind == "gap" || f.kind == "moved")
+        not_here.push_back({f.s0, f.s1});
+      if (f.kind == "moved") moved.push_back(&f);
+    }
+    std::vector<LineGeometry> pieces;
+    for (const auto& [s0, s1] : Subtract(line.s0, line.s1, not_here)) {
+      pieces.push_back(
+          {"", line.type, SampleLine(road, line.l_m, s0, s1, step)});
+    }
+    for (const DatabaseLineFault* f : moved) {
+      const double s0 = std::max(line.s0, f->s0);
+      const double s1 = std::min(line.s1, f->s1);
+      for (const auto& [a, b] : Subtract(s0, s1, gaps)) {
+        pieces.push_back({"", line.type,
+                          SampleLine(road, line.l_m + f->shift_m, a, b, step)});
+      }
+    }
+    // A piece shorter than half a metre is not something an aerial survey
+    // would digitise.
+    int k = 0;
+    for (LineGeometry& piece : pieces) {
+      const double length = (piece.points.back() - piece.points.front()).norm();
+      if (length < 0.5) continue;
+      piece.id =
+          street[i].id + (pieces.size() > 1 ? "." + std::to_string(++k) : "");
+      out.push_back(std::move(piece));
+    }
+  }
+  for (size_t i = world.lines.size(); i < street.size(); ++i) {
+    out.push_back(street[i]);  // the stop lines
+  }
+  for (const DatabaseLineFault& f : world.database_line_faults) {
+    if (f.kind != "removed") continue;
+    const StopLine stop = StopLineBefore(world, f.crossing, options);
+    out.push_back({"stop-" + world.crossings[f.crossing].id,
                    "stop_line",
                    {road.SurfacePoint(stop.s_m, stop.l0),
                     road.SurfacePoint(stop.s_m, stop.l1)}});
@@ -663,7 +784,7 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
       db.bands.push_back(out);
     }
   }
-  for (const LineGeometry& line : LineGeometries(world)) {
+  for (const LineGeometry& line : DatabaseLineGeometries(world, options)) {
     RoadmarkLine out;
     out.id = line.id;
     out.type = line.type;

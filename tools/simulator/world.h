@@ -157,6 +157,18 @@ struct Shadow {
   double InsideDistance(const Eigen::Vector2d& p) const;
 };
 
+// A stretch of a road line whose database copy differs from the street.
+struct DatabaseLineFault {
+  // "gap": missing from the database; "moved": repainted shift_m across the
+  // road since the database was made (the database holds the old position);
+  // "removed": a stop line in the database that is no longer painted.
+  std::string kind;
+  double l_m = 0.0;  // street position of the line (removed: database's)
+  double s0 = 0.0, s1 = 0.0;
+  double shift_m = 0.0;  // moved: database l minus street l
+  int crossing = -1;     // removed: the crossing it stood before
+};
+
 struct World {
   Road road;
   double s_drive_start = 0.0;  // the vehicle drives s in [start, end]
@@ -166,6 +178,7 @@ struct World {
   std::vector<Band> bands;          // painted bands, grouped by crossing
   std::vector<LinePiece> lines;
   std::vector<StopLine> stop_lines;
+  std::vector<DatabaseLineFault> database_line_faults;
   std::vector<Manhole> manholes;
   std::vector<Stain> stains;
   std::vector<Building> buildings;
@@ -192,7 +205,8 @@ RoadmarkDatabase MakeTruthRoadmarks(const World& world,
                                     const LocalFrame& frame);
 // The database: bands of crossings in_db at their database position (and
 // with their database band count), shifted by the crossing's systematic
-// offset, plus per-corner Gaussian noise; lines with noise.
+// offset, plus per-corner Gaussian noise; lines with noise and with the
+// world's database_line_faults (gaps, moved stretches, removed stop lines).
 RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
                                        const SimulationOptions& options,
                                        const LocalFrame& frame);
