@@ -41,10 +41,11 @@ need() {  # need LABEL MIN-COUNT PATTERN
 need "report title" 1 "<h1>zebrageo report"
 for section in Warnings Accuracy Trajectory "Ground control residuals" \
   Crossings "Database faults found" "Stretches without control" \
-  "Stage timings"; do
+  "Road lines" "Stage timings"; do
   need "section $section" 1 "<h2>$section</h2>"
 done
 need "inline SVG plots" 4 "<svg"
+need "road-line control plot" 1 "Road-line control per stretch"
 need "plot lines or markers" 4 "<polyline\|<circle\|<path\|<rect"
 if grep -q -- "NaN\|>nan<\|>inf<" "$work/dom.html"; then
   echo "FAIL: NaN or inf in the rendered page"
