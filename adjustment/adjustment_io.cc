@@ -77,6 +77,23 @@ nlohmann::json SummaryJson(const AdjustmentData& data,
                            : nlohmann::json(nullptr)},
       {"vertices", s.num_check_points},
       {"evaluated_vertices", s.num_check_points_evaluated},
+      {"expected_from_database",
+       {{"horizontal", checked
+                           ? nlohmann::json(s.check_database_rms_horizontal_m)
+                           : nlohmann::json(nullptr)},
+        {"vertical", checked ? nlohmann::json(s.check_database_rms_vertical_m)
+                             : nlohmann::json(nullptr)}}},
+      {"implied_trajectory",
+       {{"horizontal",
+         checked ? nlohmann::json(s.check_implied_trajectory_horizontal_m)
+                 : nlohmann::json(nullptr)},
+        {"vertical", checked
+                         ? nlohmann::json(s.check_implied_trajectory_vertical_m)
+                         : nlohmann::json(nullptr)}}},
+      {"note",
+       "check residual = trajectory error + database error; "
+       "implied_trajectory = sqrt(max(0, rmse^2 - expected_from_database^2)), "
+       "for the adjustment made without the check crossings"},
       {"crossings", s.num_check_crossings},
       {"held_out_then_control", s.check_points_in_final}};
   j["correction_m"] = {{"max_horizontal", s.max_correction_horizontal_m},

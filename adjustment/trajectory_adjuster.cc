@@ -1297,6 +1297,11 @@ AdjustmentResult AdjustTrajectory(
     }
   }
   std::vector<double> control_h, control_v, check_h, check_v;
+  // What the database alone puts into a check residual, per the model the
+  // adjustment uses for it: the vertex sigma and the crossing offset.
+  std::vector<double> database_h, database_v;
+  const double offset_variance =
+      options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
   for (ControlPoint& p : state.points) {
     ControlPointResult r;
     r.crossing_id = p.crossing_id;
@@ -1347,6 +1352,10 @@ AdjustmentResult AdjustTrajectory(
       if (triangulated) {
         check_h.push_back(d.head<2>().norm());
         check_v.push_back(d.z());
+        database_h.push_back(std::sqrt(p.sigma_m.head<2>().squaredNorm() +
+                                       2.0 * offset_variance));
+        database_v.push_back(
+            std::sqrt(p.sigma_m.z() * p.sigma_m.z() + offset_variance));
       }
     } else {
       ++summary.num_rejected_points;
@@ -1366,6 +1375,15 @@ AdjustmentResult AdjustTrajectory(
   summary.check_rmse_horizontal_m = Rms(check_h);
   summary.check_rmse_vertical_m = Rms(check_v);
   summary.num_check_points_evaluated = static_cast<int>(check_h.size());
+  summary.check_database_rms_horizontal_m = Rms(database_h);
+  summary.check_database_rms_vertical_m = Rms(database_v);
+  auto implied = [](double rmse, double database) {
+    return std::sqrt(std::max(0.0, rmse * rmse - database * database));
+  };
+  summary.check_implied_trajectory_horizontal_m = implied(
+      summary.check_rmse_horizontal_m, summary.check_database_rms_horizontal_m);
+  summary.check_implied_trajectory_vertical_m = implied(
+      summary.check_rmse_vertical_m, summary.check_database_rms_vertical_m);
   if (summary.num_rejected_points > 0) {
     std::set<std::string> names;
     for (const ControlPoint& p : state.points) {

@@ -239,6 +239,16 @@ struct AdjustmentSummary {
   double check_rmse_horizontal_m = 0.0;
   double check_rmse_vertical_m = 0.0;
   int num_check_points_evaluated = 0;
+  // A check residual holds the database's error too (per the adjustment's
+  // model of it: the stated vertex sigma and crossing_offset_sigma_m): its
+  // expected RMS, and the trajectory error the check RMSE implies once it
+  // is removed, sqrt(max(0, rmse^2 - database^2)). The check points measure
+  // the adjustment made without them (fewer control crossings), so this is
+  // a pessimistic figure for the final trajectory.
+  double check_database_rms_horizontal_m = 0.0;
+  double check_database_rms_vertical_m = 0.0;
+  double check_implied_trajectory_horizontal_m = 0.0;
+  double check_implied_trajectory_vertical_m = 0.0;
   // Size of the correction applied to the trajectory samples.
   // GNSS/INS position sigma of the prior (estimated or as configured).
   double gnss_sigma_horizontal_m = 0.0;

@@ -95,6 +95,28 @@ TEST(TrajectoryAdjuster, CheckPointsAreHeldOutAndMeasureAnHonestAccuracy) {
   const double expected = std::hypot(after.rmse_horizontal_m, database_h);
   EXPECT_GT(result.summary.check_rmse_horizontal_m, 0.4 * expected);
   EXPECT_LT(result.summary.check_rmse_horizontal_m, 2.5 * expected);
+  // The database's part, per the adjustment's model of it, and the
+  // trajectory error left once it is removed.
+  const AdjustmentSummary& s = result.summary;
+  EXPECT_EQ(s.num_check_points_evaluated, s.num_check_points);
+  EXPECT_GT(s.check_database_rms_horizontal_m, 0.0);
+  EXPECT_NEAR(
+      std::hypot(s.check_implied_trajectory_horizontal_m,
+                 s.check_database_rms_horizontal_m),
+      std::max(s.check_rmse_horizontal_m, s.check_database_rms_horizontal_m),
+      1e-9);
+  EXPECT_LE(s.check_implied_trajectory_horizontal_m, s.check_rmse_horizontal_m);
+}
+
+TEST(TrajectoryAdjuster, NoCheckCrossingMeansNoCheckFigure) {
+  const Fixture f = MakeFixture(KilometreOptions());
+  AdjustmentOptions options;
+  options.check_crossing_share = 0.0;
+  const AdjustmentResult result = AdjustTrajectory(options, f.Input());
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  EXPECT_EQ(result.summary.num_check_crossings, 0);
+  // Reported as null (adjustment_io), not as a perfect 0.
+  EXPECT_EQ(result.summary.num_check_points_evaluated, 0);
 }
 
 TEST(TrajectoryAdjuster, WrongControlPointsAreFlaggedAndRemoved) {
