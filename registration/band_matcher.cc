@@ -519,12 +519,24 @@ Eval Matcher::Evaluate(const Obs& obs, const PoseCorrection& c) const {
       crossings.insert(index_.bands()[h.db].crossing);
     }
     const Pose pose = CorrectedPose(obs.source->pose, c);
+    std::vector<BandCornersEnu> seen;
+    if (input_.paint_probe) {
+      for (const Hit& h : eval.hits)
+        seen.push_back(index_.bands()[h.db].corners_enu);
+    }
     for (int crossing : crossings) {
       for (int b : index_.crossings()[crossing].bands) {
         if (used_db.count(b)) continue;
-        if (visibility_.BandVisible(pose, index_.bands()[b])) {
-          eval.missing.push_back(b);
+        if (!visibility_.BandVisible(pose, index_.bands()[b])) continue;
+        // A band the reconstruction missed (hidden, worn, lost at range) is
+        // no evidence; bare road where the hypothesis puts paint is.
+        if (input_.paint_probe &&
+            input_.paint_probe(obs.source->exposure_id, pose,
+                               index_.bands()[b].corners_enu,
+                               seen) != PaintEvidence::kBareRoad) {
+          continue;
         }
+        eval.missing.push_back(b);
       }
     }
   }

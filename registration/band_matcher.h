@@ -59,6 +59,7 @@
 #include <string>
 #include <vector>
 
+#include "registration/paint_probe.h"
 #include "registration/roadmark_index.h"
 #include "survey/results.h"
 #include "survey/rig.h"
@@ -226,6 +227,15 @@ struct MatchInput {
   // Cameras for visibility reasoning; nullptr: no missing-band evidence
   // (fewer matches, never wrong ones).
   const Rig* rig = nullptr;
+  // Image evidence (paint_probe.h): what the image shows where a database
+  // band is predicted in view but was not reconstructed. Only kBareRoad
+  // makes it a missing band (evidence against the hypothesis); empty: every
+  // such band counts as missing, and an end band hidden in every view can
+  // pass for a one-band shift.
+  std::function<PaintEvidence(int64_t exposure_id, const Pose& pose,
+                              const BandCornersEnu& band,
+                              const std::vector<BandCornersEnu>& seen)>
+      paint_probe;
 };
 
 enum class FaultKind {

@@ -11,6 +11,7 @@
 #include <tuple>
 #include <utility>
 
+#include "registration/paint_probe.h"
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
 
@@ -362,6 +363,12 @@ MatchResult RunMatchStage(const Survey& survey,
   const RoadmarkIndex index(survey.roadmarks, survey.frame);
   input.index = &index;
   input.rig = &survey.rig;
+  ImagePaintProbe probe(survey);
+  input.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
+                               const BandCornersEnu& band,
+                               const std::vector<BandCornersEnu>& seen) {
+    return probe.Classify(exposure_id, pose, band, seen);
+  };
   std::vector<std::string> warnings;
   if (incomplete > 0) {
     warnings.push_back(std::to_string(incomplete) +

@@ -239,6 +239,44 @@ TEST(BandMatcher, WithBothEndsRequiredNeverGuessesAnEndBandHiddenFromAllViews) {
   EXPECT_EQ(run.score.wrong, 0);
 }
 
+TEST(BandMatcher,
+     ImageEvidenceKeepsAnEndBandHiddenFromAllViewsFromPassingForAShift) {
+  // A vehicle at the kerb hides band 1 of every crossing from every view:
+  // from the bands alone this is the crossing shifted by one band, whose
+  // extra band falls out of view. Counting every predicted band in view as
+  // missing picks the shift; image evidence (here a perfect probe: paint
+  // where the street has a band, the vehicle where it hides band 1, bare
+  // road elsewhere) must not.
+  for (int seed = 1; seed <= 3; ++seed) {
+    SyntheticSceneOptions options = Street(seed);
+    for (SyntheticCrossingSpec& c : options.crossings) {
+      c.occluded_bands = 1;
+      c.occluded_beyond_m = 1e-3;
+    }
+    const SyntheticScene scene = MakeSyntheticScene(options);
+    const RoadmarkIndex index(scene.database, scene.frame);
+    MatchInput input = scene.Input(index);
+    input.paint_probe = [&scene](int64_t, const Pose&,
+                                 const BandCornersEnu& band,
+                                 const std::vector<BandCornersEnu>&) {
+      const Eigen::Vector3d centre =
+          0.25 * (band[0] + band[1] + band[2] + band[3]);
+      for (const auto& [key, corners] : scene.truth) {
+        const Eigen::Vector3d c =
+            0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+        if ((c - centre).head<2>().norm() > 0.3) continue;
+        return key.second == 1 ? PaintEvidence::kUnknown
+                               : PaintEvidence::kPaint;
+      }
+      return PaintEvidence::kBareRoad;
+    };
+    const MatchResult with_probe = MatchBands(input, MatchOptions());
+    const MatchScore score = ScoreMatches(scene, with_probe.matches);
+    SCOPED_TRACE(with_probe.summary.BriefReport());
+    EXPECT_EQ(score.wrong, 0);
+  }
+}
+
 TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
   // The database has crossing C03 one band period off (a wrong survey): it
   // still fits perfectly alone, but implies a correction 1 m away from the

@@ -1,0 +1,220 @@
+#include "registration/paint_probe.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <sstream>
+
+#include "survey/image_io.h"
+
+namespace zebrageo {
+namespace {
+
+// Median and interquartile range of `values` (reordered).
+void Quartiles(std::vector<float>* values, double* median, double* iqr) {
+  const size_t n = values->size();
+  auto at = [&](double share) {
+    auto it = values->begin() + static_cast<ptrdiff_t>(share * (n - 1));
+    std::nth_element(values->begin(), it, values->end());
+    return static_cast<double>(*it);
+  };
+  *median = at(0.5);
+  *iqr = at(0.75) - at(0.25);
+}
+
+// The quad midway between two neighbouring bands: the asphalt gap.
+BandCornersEnu Between(const BandCornersEnu& a, const BandCornersEnu& b) {
+  BandCornersEnu gap;
+  for (int k = 0; k < 4; ++k) gap[k] = 0.5 * (a[k] + b[k]);
+  return gap;
+}
+
+// Horizontal unit vector across the band (along its shorter sides).
+Eigen::Vector3d AcrossUnit(const BandCornersEnu& q) {
+  Eigen::Vector3d a = q[1] - q[0];
+  const Eigen::Vector3d b = q[2] - q[1];
+  if (b.head<2>().norm() < a.head<2>().norm()) a = b;
+  a.z() = 0.0;
+  return a.norm() > 0.0 ? Eigen::Vector3d(a / a.norm()) : a;
+}
+
+Eigen::Vector3d Centre(const BandCornersEnu& q) {
+  return 0.25 * (q[0] + q[1] + q[2] + q[3]);
+}
+
+}  // namespace
+
+const char* PaintEvidenceName(PaintEvidence evidence) {
+  switch (evidence) {
+    case PaintEvidence::kPaint:
+      return "paint";
+    case PaintEvidence::kBareRoad:
+      return "bare road";
+    case PaintEvidence::kUnknown:
+      break;
+  }
+  return "unknown";
+}
+
+std::string PaintProbeOptions::Check() const {
+  std::ostringstream e;
+  if (!(sample_share > 0.0 && sample_share <= 1.0)) {
+    e << "sample_share = " << sample_share << ": must be in (0, 1]";
+  } else if (!(min_contrast > 0.0)) {
+    e << "min_contrast = " << min_contrast << ": must be positive";
+  } else if (!(bare_level >= 0.0 && bare_level < paint_level &&
+               paint_level <= 1.0)) {
+    e << "bare_level, paint_level = " << bare_level << ", " << paint_level
+      << ": need 0 <= bare_level < paint_level <= 1";
+  } else if (!(max_bare_spread > 0.0)) {
+    e << "max_bare_spread = " << max_bare_spread << ": must be positive";
+  } else if (!(min_inside_share > 0.0 && min_inside_share <= 1.0)) {
+    e << "min_inside_share = " << min_inside_share << ": must be in (0, 1]";
+  } else if (cached_images < 1) {
+    e << "cached_images = " << cached_images << ": must be at least 1";
+  }
+  const std::string error = e.str();
+  return error.empty() ? error : "paint probe options: " + error;
+}
+
+ImagePaintProbe::ImagePaintProbe(const Survey& survey,
+                                 PaintProbeOptions options)
+    : survey_(survey), options_(options) {
+  if (survey.rig.stereo_pairs.empty()) return;
+  camera_ = survey.rig.stereo_pairs.front()[0];
+  for (const Exposure& e : survey.exposures.exposures) {
+    if (camera_ >= static_cast<int>(e.image_of_camera.size())) continue;
+    const int image = e.image_of_camera[camera_];
+    if (image >= 0) {
+      image_of_exposure_[e.exposure_id] = survey.exposures.images[image].image;
+    }
+  }
+}
+
+const cv::Mat* ImagePaintProbe::LeftImage(int64_t exposure_id) {
+  for (auto it = cache_.begin(); it != cache_.end(); ++it) {
+    if (it->first != exposure_id) continue;
+    cache_.splice(cache_.begin(), cache_, it);
+    return &cache_.front().second;
+  }
+  const auto path = image_of_exposure_.find(exposure_id);
+  if (path == image_of_exposure_.end()) return nullptr;
+  cv::Mat image;
+  try {
+    const Camera& camera = survey_.rig.cameras[camera_].camera;
+    image = ReadGrayImage(survey_.PathOf(path->second), path->second,
+                          camera.width(), camera.height());
+  } catch (const std::exception& error) {
+    // The reconstruction already reported unreadable images; here the
+    // evidence is simply unknown.
+    VLOG(1) << "paint probe: " << error.what();
+  }
+  ++images_read_;
+  cache_.emplace_front(exposure_id, image);
+  if (static_cast<int>(cache_.size()) > options_.cached_images) {
+    cache_.pop_back();
+  }
+  return cache_.front().second.empty() ? nullptr : &cache_.front().second;
+}
+
+bool ImagePaintProbe::Sample(const cv::Mat& image,
+                             const Eigen::Isometry3d& T_cam_enu,
+                             const BandCornersEnu& quad,
+                             std::vector<float>* values) const {
+  const Camera& camera = survey_.rig.cameras[camera_].camera;
+  constexpr int kAlong = 15;
+  constexpr int kAcross = 7;
+  const double lo = 0.5 - 0.5 * options_.sample_share;
+  values->clear();
+  int total = 0;
+  for (int i = 0; i < kAlong; ++i) {
+    for (int j = 0; j < kAcross; ++j) {
+      // Bilinear in the ring 0-1-2-3: 0-1 and 3-2 across, 0-3 along, or
+      // the other way round; a symmetric grid does not care which.
+      const double u = lo + options_.sample_share * i / (kAlong - 1);
+      const double v = lo + options_.sample_share * j / (kAcross - 1);
+      const Eigen::Vector3d p = (1 - u) * ((1 - v) * quad[0] + v * quad[1]) +
+                                u * ((1 - v) * quad[3] + v * quad[2]);
+      ++total;
+      const Eigen::Vector3d p_cam = T_cam_enu * p;
+      Eigen::Vector2d uv;
+      if (p_cam.z() < 0.5 || !camera.Project(p_cam, &uv) ||
+          !camera.IsInImage(uv, 2.0)) {
+        continue;
+      }
+      const int x = static_cast<int>(std::lround(uv.x()));
+      const int y = static_cast<int>(std::lround(uv.y()));
+      if (x < 0 || y < 0 || x >= image.cols || y >= image.rows) continue;
+      values->push_back(image.at<float>(y, x));
+    }
+  }
+  return values->size() >= options_.min_inside_share * total;
+}
+
+PaintEvidence ImagePaintProbe::Classify(
+    int64_t exposure_id, const Pose& pose, const BandCornersEnu& band,
+    const std::vector<BandCornersEnu>& seen) {
+  if (camera_ < 0 || seen.empty()) return PaintEvidence::kUnknown;
+  const cv::Mat* image = LeftImage(exposure_id);
+  if (image == nullptr) return PaintEvidence::kUnknown;
+  const Eigen::Isometry3d T_cam_enu =
+      (pose.T_enu_body() * survey_.rig.cameras[camera_].T_body_cam).inverse();
+  // Paint: the seen bands. Asphalt: the gaps between neighbouring ones.
+  std::vector<float> paint, asphalt, values;
+  for (size_t i = 0; i < seen.size(); ++i) {
+    if (Sample(*image, T_cam_enu, seen[i], &values)) {
+      paint.insert(paint.end(), values.begin(), values.end());
+    }
+    for (size_t j = i + 1; j < seen.size(); ++j) {
+      const double apart = (Centre(seen[i]) - Centre(seen[j])).norm();
+      if (apart < 0.7 || apart > 1.3) continue;  // not neighbours
+      if (Sample(*image, T_cam_enu, Between(seen[i], seen[j]), &values)) {
+        asphalt.insert(asphalt.end(), values.begin(), values.end());
+      }
+    }
+  }
+  if (paint.empty() || asphalt.empty()) return PaintEvidence::kUnknown;
+  double paint_level, paint_spread, road_level, road_spread;
+  Quartiles(&paint, &paint_level, &paint_spread);
+  Quartiles(&asphalt, &road_level, &road_spread);
+  // Ratios, not differences: a cast shadow multiplies paint and asphalt
+  // alike, so the band is compared with the surface right beside it.
+  if (!(road_level > 1.0) || paint_level - road_level < options_.min_contrast) {
+    return PaintEvidence::kUnknown;
+  }
+  const double contrast = paint_level / road_level - 1.0;
+  if (!Sample(*image, T_cam_enu, band, &values)) {
+    return PaintEvidence::kUnknown;
+  }
+  double level, spread;
+  Quartiles(&values, &level, &spread);
+  // Beside the band, half a band period either way: the gaps.
+  const Eigen::Vector3d across = AcrossUnit(band);
+  std::vector<float> beside;
+  for (double sign : {-1.0, 1.0}) {
+    BandCornersEnu side = band;
+    for (Eigen::Vector3d& corner : side) corner += sign * 0.5 * across;
+    if (Sample(*image, T_cam_enu, side, &values)) {
+      beside.insert(beside.end(), values.begin(), values.end());
+    }
+  }
+  if (beside.empty()) return PaintEvidence::kUnknown;
+  double local_level, local_spread;
+  Quartiles(&beside, &local_level, &local_spread);
+  if (!(local_level > 1.0)) return PaintEvidence::kUnknown;
+  const double share = (level / local_level - 1.0) / contrast;
+  VLOG(2) << "paint probe: exposure " << exposure_id << " paint " << paint_level
+          << " asphalt " << road_level << " band " << level << " (" << spread
+          << ") beside " << local_level << " (" << local_spread << "): share "
+          << share;
+  if (share >= options_.paint_level) return PaintEvidence::kPaint;
+  if (std::abs(share) <= options_.bare_level &&
+      spread <= local_spread + options_.max_bare_spread * contrast * level) {
+    return PaintEvidence::kBareRoad;
+  }
+  return PaintEvidence::kUnknown;
+}
+
+}  // namespace zebrageo

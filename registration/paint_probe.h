@@ -1,0 +1,102 @@
+// Image evidence for the 1 m periodicity of zebra bands (issue 6).
+//
+// A database band predicted in view but not reconstructed is evidence
+// against the hypothesis that predicts it only if the street there is bare
+// road: a band the reconstruction missed (worn paint, a vehicle hiding it,
+// an edge lost at range) says nothing. Without this, an end band hidden in
+// every view looks exactly like a one-band shift of the whole crossing, and
+// the hypothesis whose extra band falls outside the images wins.
+//
+// The probe looks at the left image of the stereo pair where the band would
+// be, projected with the hypothesis' corrected pose, and compares it with
+// the paint of the bands matched in the same image and the asphalt between
+// them: paint-bright is kPaint, asphalt-dark and as even as the asphalt is
+// kBareRoad, anything else (a vehicle, a shadow edge, too little contrast,
+// out of the image) is kUnknown.
+//
+// Known limit: an even, dark occluder (the plain side of a dark vehicle)
+// looks like bare road; the continuity check between crossings and the
+// adjustment's blunder test remain behind it.
+#ifndef ZEBRAGEO_REGISTRATION_PAINT_PROBE_H_
+#define ZEBRAGEO_REGISTRATION_PAINT_PROBE_H_
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <list>
+#include <opencv2/core.hpp>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "survey/survey.h"
+#include "survey/trajectory.h"
+
+namespace zebrageo {
+
+enum class PaintEvidence { kUnknown, kPaint, kBareRoad };
+
+const char* PaintEvidenceName(PaintEvidence evidence);
+
+using BandCornersEnu = std::array<Eigen::Vector3d, 4>;
+
+struct PaintProbeOptions {
+  // Samples are taken in the middle part of the band (this share of its
+  // length and width): the database is 5-15 cm off.
+  double sample_share = 0.5;
+  // Paint minus asphalt (grey levels) below this: cannot tell.
+  double min_contrast = 15.0;
+  // The band's median against the surface right beside it (the gaps half a
+  // period either way), as a share of the paint/asphalt ratio of the seen
+  // bands (ratios: a cast shadow darkens paint and asphalt alike): above
+  // paint_level it is paint; within +-bare_level of the surface beside it,
+  // and as even, it is bare (asphalt, or the sidewalk beyond the crossing).
+  double paint_level = 0.6;
+  double bare_level = 0.3;
+  // Evenness: the spread (interquartile range) of the band's samples at
+  // most the spread beside it plus this share of the paint contrast.
+  double max_bare_spread = 0.35;
+  // Share of the samples that must fall inside the image.
+  double min_inside_share = 0.8;
+  // Decoded images kept in memory.
+  int cached_images = 16;
+
+  std::string Check() const;
+};
+
+class ImagePaintProbe {
+ public:
+  // `survey` must outlive the probe.
+  explicit ImagePaintProbe(const Survey& survey,
+                           PaintProbeOptions options = PaintProbeOptions());
+
+  // What the left image of the first stereo pair of `exposure_id` shows
+  // inside `band`, seen from the body pose `pose`, given `seen` (database
+  // bands matched in that image: their paint, and the asphalt between
+  // neighbours). Never throws: an unreadable image is kUnknown.
+  PaintEvidence Classify(int64_t exposure_id, const Pose& pose,
+                         const BandCornersEnu& band,
+                         const std::vector<BandCornersEnu>& seen);
+
+  // Images decoded so far (for the bench).
+  int images_read() const { return images_read_; }
+
+ private:
+  // Grey values at a grid over the middle of `quad` (ENU), those inside the
+  // image; false when too few are.
+  bool Sample(const cv::Mat& image, const Eigen::Isometry3d& T_cam_enu,
+              const BandCornersEnu& quad, std::vector<float>* values) const;
+  const cv::Mat* LeftImage(int64_t exposure_id);
+
+  const Survey& survey_;
+  PaintProbeOptions options_;
+  int camera_ = -1;  // the left camera of the first stereo pair
+  std::unordered_map<int64_t, std::string> image_of_exposure_;
+  std::list<std::pair<int64_t, cv::Mat>> cache_;  // most recent first
+  int images_read_ = 0;
+};
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_REGISTRATION_PAINT_PROBE_H_
