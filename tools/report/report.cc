@@ -285,6 +285,21 @@ json UncontrolledStretches(const ReportData& data,
   return stretches;
 }
 
+// True when road-line points controlled cross-track over most of the
+// 30 s stretches overlapping [t0, t1] (absolute times).
+bool RoadLinesControl(const json& road_lines, double t0, double t1) {
+  if (!road_lines.is_object()) return false;
+  const double length = road_lines.value("stretch_s", 0.0);
+  int overlapping = 0, controlled = 0;
+  for (const json& s : road_lines.value("stretches", json::array())) {
+    const double a = s.value("time0", 0.0);
+    if (a + length <= t0 || a >= t1) continue;
+    ++overlapping;
+    if (s.value("cross_track_points", 0) > 0) ++controlled;
+  }
+  return overlapping > 0 && 2 * controlled > overlapping;
+}
+
 json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
                    const ReportData& data) {
   const Survey& survey = *inputs.survey;
@@ -400,12 +415,20 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
         "no zebra crossing was matched: the trajectory is not "
         "controlled anywhere");
   }
-  for (const json& s : report["uncontrolled_stretches"]) {
+  for (json& s : report["uncontrolled_stretches"]) {
+    const bool lines = RoadLinesControl(report.value("road_lines", json()),
+                                        s["start_time_s"].get<double>(),
+                                        s["end_time_s"].get<double>());
+    s["road_lines_control_cross_track_and_height"] = lines;
     std::ostringstream text;
     text.precision(0);
-    text << std::fixed << "no control over " << s["length_m"].get<double>()
+    text << std::fixed << "no zebra crossing control over "
+         << s["length_m"].get<double>()
          << " m of trajectory (t = " << s["start_time_s"].get<double>()
-         << " to " << s["end_time_s"].get<double>() << " s)";
+         << " to " << s["end_time_s"].get<double>() << " s)"
+         << (lines ? ": road lines control cross-track and height there, "
+                     "along-track is not controlled"
+                   : "");
     warnings.push_back(text.str());
   }
   if (data.adjustment.is_object() && data.adjustment.contains("sigma0") &&
