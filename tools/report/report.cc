@@ -422,11 +422,10 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
     s["road_lines_control_cross_track_and_height"] = lines;
     std::ostringstream text;
     text.precision(0);
-    text << std::fixed << "no zebra crossing control over "
-         << s["length_m"].get<double>()
+    text << std::fixed << "no control over " << s["length_m"].get<double>()
          << " m of trajectory (t = " << s["start_time_s"].get<double>()
-         << " to " << s["end_time_s"].get<double>() << " s)"
-         << (lines ? ": road lines control cross-track and height there, "
+         << " to " << s["end_time_s"].get<double>() << " s) by zebra crossings"
+         << (lines ? "; road lines control cross-track and height there, "
                      "along-track is not controlled"
                    : "");
     warnings.push_back(text.str());
