@@ -126,6 +126,7 @@ std::vector<LinePointMatch> MatchLinePoints(
       LinePointMatch m;
       m.point = static_cast<int>(i);
       m.db_line = best.line;
+      m.db_segment = best.segment;
       m.db_point_enu = a + best.t * (b - a);
       m.along_enu = along;
       m.across_enu = Eigen::Vector3d(-along.y(), along.x(), 0.0);

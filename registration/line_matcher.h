@@ -63,8 +63,9 @@ struct LinePointEnu {
 };
 
 struct LinePointMatch {
-  int point = 0;    // index into the points
-  int db_line = 0;  // index into the database lines
+  int point = 0;       // index into the points
+  int db_line = 0;     // index into the database lines
+  int db_segment = 0;  // its segment (points[db_segment], points[+1])
   // The matched database segment's point nearest (horizontally) to the
   // reconstructed point, and the directions the match constrains.
   Eigen::Vector3d db_point_enu = Eigen::Vector3d::Zero();

@@ -186,8 +186,18 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   std::map<int, std::array<int, 3>> stretches;  // cross-track, height, along
   csv.Header({"exposure_id", "line_id", "point", "type", "db_line", "across_e",
               "across_n", "distance_m", "height_m", "constrains"});
+  // The database's error is one per segment, shared by every point matched
+  // to it (from several exposures): counted once, or the adjustment would
+  // fit the database's noise (the heading follows the digitised line's
+  // wiggles between crossings).
+  std::map<std::pair<int, int>, int> points_on_segment;
+  for (const LinePointMatch& m : matches) {
+    ++points_on_segment[{m.db_line, m.db_segment}];
+  }
   for (const LinePointMatch& m : matches) {
     const ReconstructedLinePoint& p = points[source[m.point]];
+    const double shared = std::sqrt(
+        static_cast<double>(points_on_segment[{m.db_line, m.db_segment}]));
     const Pose& pose = pose_of[m.point];
     const DatabaseLineEnu& line = database[m.db_line];
     LineControlPoint c;
@@ -197,8 +207,8 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     c.across_enu = m.across_enu;
     c.sqrt_information = LineSqrtInformation(
         p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
-        std::max(line.sigma_xy_m, options.min_database_sigma_m),
-        std::max(line.sigma_z_m, options.min_database_sigma_m));
+        shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),
+        shared * std::max(line.sigma_z_m, options.min_database_sigma_m));
     control.push_back(c);
     // Across the line is cross-track when the line runs with the vehicle.
     const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
