@@ -2,85 +2,34 @@
 // 1280 x 960 images of a simulated street with a zebra crossing, parked
 // vehicles and facades. Target: <= 200 ms per stereo pair.
 //
-// The survey is simulated once into a temporary folder (or taken from
-// $ZEBRAGEO_BENCH_SURVEY); its images are decoded before timing (image
-// reading is reported separately by `zebrageo reconstruct`).
+// The survey is bench/bench_survey.h's (image reading is reported
+// separately by `zebrageo reconstruct`).
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
-#include <cstdlib>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "bench/bench_survey.h"
 #include "reconstruction/reconstruction.h"
-#include "survey/image_io.h"
-#include "survey/survey.h"
-#include "tools/simulator/simulator.h"
 
 namespace zebrageo {
 namespace {
 
+// The shared bench survey, and the pair reconstructor on its road plane.
 struct Fixture {
-  std::string folder;
-  bool owns_folder = false;
-  std::unique_ptr<Survey> survey;
+  BenchSurvey survey{"reconstruction-bench"};
   std::unique_ptr<StereoPairReconstructor> pair;
-  RoadPlane road;
-  std::vector<std::pair<cv::Mat, cv::Mat>> images;
+  const RoadPlane& road = survey.road;
+  const std::vector<std::pair<cv::Mat, cv::Mat>>& images = survey.images;
 
   Fixture() {
-    const char* given = std::getenv("ZEBRAGEO_BENCH_SURVEY");
-    if (given != nullptr) {
-      folder = given;
-    } else {
-      folder = (std::filesystem::temp_directory_path() /
-                ("zebrageo-reconstruction-bench-" + std::to_string(::getpid())))
-                   .string();
-      owns_folder = true;
-      SimulationOptions options;
-      ApplyPreset("urban", &options);
-      options.seed = 3;
-      options.road_length_m = 60.0;
-      options.num_crossings = 1;
-      options.num_stale_crossings = 0;
-      options.num_missing_crossings = 0;
-      options.num_missing_bands = 0;
-      options.num_repainted_crossings = 0;
-      options.min_crossing_spacing_m = 25.0;
-      SimulateSurvey(options, folder, nullptr);
-    }
-    SurveyLoadOptions load;
-    load.load_roadmarks = false;
-    survey = std::make_unique<Survey>(LoadSurvey(folder, load));
-    // The road plane as the survey run estimates it.
     ReconstructionOptions options;
     options.threads = 1;
-    Survey first = *survey;
-    first.exposures.exposures.resize(
-        std::min<size_t>(8, first.exposures.exposures.size()));
-    std::vector<ReconstructedVertex> unused;
-    road = ReconstructSurvey(first, options, &unused).final_road_plane;
-    const Rig& rig = survey->rig;
+    const Rig& rig = survey.survey->rig;
     pair = std::make_unique<StereoPairReconstructor>(
         rig.cameras[rig.stereo_pairs[0][0]],
         rig.cameras[rig.stereo_pairs[0][1]], road, options);
-    for (const Exposure& e : survey->exposures.exposures) {
-      cv::Mat sides[2];
-      for (int s = 0; s < 2; ++s) {
-        const ExposureImage& image =
-            survey->exposures.images[e.image_of_camera[rig.stereo_pairs[0][s]]];
-        sides[s] = ReadGrayImage(survey->PathOf(image.image), image.image);
-      }
-      images.emplace_back(sides[0], sides[1]);
-    }
-  }
-  ~Fixture() {
-    if (owns_folder) {
-      std::error_code ignored;
-      std::filesystem::remove_all(folder, ignored);
-    }
   }
 };
 
@@ -120,7 +69,7 @@ BENCHMARK(BM_StereoPair)->Unit(benchmark::kMillisecond)->MinTime(5.0);
 // Building the rectification tables of a pair (once per survey).
 void BM_BuildRectification(benchmark::State& state) {
   Fixture& f = TheFixture();
-  const Rig& rig = f.survey->rig;
+  const Rig& rig = f.survey.survey->rig;
   for (auto _ : state) {
     RoadRectification rectification;
     std::string error;
