@@ -33,9 +33,10 @@ struct Fixture {
   }
 };
 
+// Destroyed at exit, which removes the simulated survey.
 Fixture& TheFixture() {
-  static Fixture* fixture = new Fixture();
-  return *fixture;
+  static Fixture fixture;
+  return fixture;
 }
 
 // One stereo pair, all steps, one thread (CPU time of the thread).
