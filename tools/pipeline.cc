@@ -43,12 +43,29 @@ bool OutputsPresent(const std::string& folder, const PipelineStage& stage) {
   return true;
 }
 
+// The running executable's size and time: a rebuilt zebrageo (a development
+// build keeps its version number) must not resume outputs of the old one.
+std::string ExecutableStamp() {
+  std::error_code error;
+  const std::filesystem::path self =
+      std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return "";
+  const auto size = std::filesystem::file_size(self, error);
+  if (error) return "";
+  const auto time = std::filesystem::last_write_time(self, error);
+  if (error) return "";
+  std::ostringstream stamp;
+  stamp << size << ":" << time.time_since_epoch().count();
+  return stamp.str();
+}
+
 }  // namespace
 
 std::string InputFingerprint(const std::vector<std::string>& input_files,
                              const std::string& settings) {
   std::ostringstream text;
-  text << ZEBRAGEO_VERSION_STRING << "|" << settings;
+  text << ZEBRAGEO_VERSION_STRING << "|" << ExecutableStamp() << "|"
+       << settings;
   for (const std::string& file : input_files) {
     std::error_code error;
     const auto size = std::filesystem::file_size(file, error);
