@@ -5,6 +5,8 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <unordered_map>
+#include <utility>
 
 namespace zebrageo {
 namespace {
@@ -30,6 +32,64 @@ struct Nearest {
   int segment = -1;
   double t = 0.0;
   double distance = std::numeric_limits<double>::infinity();
+};
+
+// The database's segments in a uniform grid, so that a point meets only
+// the segments near it (a city's database holds tens of thousands of lines).
+class SegmentGrid {
+ public:
+  SegmentGrid(const std::vector<DatabaseLineEnu>& database, double cell_m)
+      : cell_m_(cell_m) {
+    for (int l = 0; l < static_cast<int>(database.size()); ++l) {
+      const auto& points = database[l].points;
+      for (int s = 0; s + 1 < static_cast<int>(points.size()); ++s) {
+        const Eigen::Vector2d a = points[s].head<2>();
+        const Eigen::Vector2d b = points[s + 1].head<2>();
+        const auto [x0, y0] = Cell(a.cwiseMin(b));
+        const auto [x1, y1] = Cell(a.cwiseMax(b));
+        for (int64_t x = x0; x <= x1; ++x) {
+          for (int64_t y = y0; y <= y1; ++y)
+            cells_[Key(x, y)].push_back({l, s});
+        }
+      }
+    }
+  }
+
+  // Every segment with a part within `radius` of p (and a few more), each
+  // once, grouped by line in `out`.
+  void Near(const Eigen::Vector2d& p, double radius,
+            std::map<int, std::vector<int>>* out) const {
+    out->clear();
+    const Eigen::Vector2d r(radius, radius);
+    const auto [x0, y0] = Cell(p - r);
+    const auto [x1, y1] = Cell(p + r);
+    for (int64_t x = x0; x <= x1; ++x) {
+      for (int64_t y = y0; y <= y1; ++y) {
+        const auto it = cells_.find(Key(x, y));
+        if (it == cells_.end()) continue;
+        for (const auto& [line, segment] : it->second) {
+          (*out)[line].push_back(segment);
+        }
+      }
+    }
+    for (auto& [line, segments] : *out) {
+      std::sort(segments.begin(), segments.end());
+      segments.erase(std::unique(segments.begin(), segments.end()),
+                     segments.end());
+    }
+  }
+
+ private:
+  std::pair<int64_t, int64_t> Cell(const Eigen::Vector2d& p) const {
+    return {static_cast<int64_t>(std::floor(p.x() / cell_m_)),
+            static_cast<int64_t>(std::floor(p.y() / cell_m_))};
+  }
+  static uint64_t Key(int64_t x, int64_t y) {
+    return (static_cast<uint64_t>(x) << 32) ^
+           (static_cast<uint64_t>(y) & 0xffffffffULL);
+  }
+  double cell_m_;
+  std::unordered_map<uint64_t, std::vector<std::pair<int, int>>> cells_;
 };
 
 }  // namespace
@@ -72,6 +132,13 @@ std::vector<LinePointMatch> MatchLinePoints(
     const std::vector<DatabaseLineEnu>& database,
     const LineMatchOptions& options) {
   std::vector<LinePointMatch> out;
+  // Lines farther than this cannot change a decision: a point is kept when
+  // its nearest line is within gate_m and every other one is beyond both
+  // gate_m and min_separation_ratio times that.
+  const double radius =
+      std::max(1.0, options.min_separation_ratio) * options.gate_m;
+  const SegmentGrid grid(database, std::max(2.0, radius));
+  std::map<int, std::vector<int>> near;
   size_t begin = 0;
   while (begin < points.size()) {
     size_t end = begin + 1;
@@ -90,14 +157,15 @@ std::vector<LinePointMatch> MatchLinePoints(
       const LinePointEnu& p = points[i];
       // Nearest compatible line, and the nearest other line of any type.
       Nearest best, second;
-      for (int l = 0; l < static_cast<int>(database.size()); ++l) {
+      grid.Near(p.p_enu.head<2>(), radius, &near);
+      for (const auto& [l, segments] : near) {
         const DatabaseLineEnu& line = database[l];
         Nearest n;
-        for (size_t s = 0; s + 1 < line.points.size(); ++s) {
+        for (const int s : segments) {
           double t = 0.0;
           const double d = SegmentDistance2d(p.p_enu, line.points[s],
                                              line.points[s + 1], &t);
-          if (d < n.distance) n = {l, static_cast<int>(s), t, d};
+          if (d < n.distance) n = {l, s, t, d};
         }
         if (!Compatible(p.type, line.type)) {
           second.distance = std::min(second.distance, n.distance);
