@@ -6,11 +6,15 @@
 //   X = p_ins + dp + Exp(dtheta) R_ins p_body      (cost_functions.h),
 // and compared with the database line there in the two directions a line
 // constrains: across it (horizontal unit normal) and in height:
-//   r = S [across . (X - D), (X - D).z]
-// D: the database line's point nearest to the match; S: the whitening of
-// both uncertainties (the reconstruction's covariance rotated to ENU, plus
-// the database's sigma_xy and sigma_z). Along the line nothing is
-// constrained.
+//   r = S [across . (X - D), (X - D).z - grade along . (X - D)]
+// D: the database line's point nearest to the match (placed with the INS
+// trajectory); along, grade: the horizontal direction of its segment and
+// its slope (dz per horizontal metre), so the height is compared with the
+// line where the corrected point lies, not where the drifting INS put it
+// (a metre of along-track drift on a 3 % grade is 3 cm of height, and a
+// tilt of the trajectory). S: the whitening of both uncertainties (the
+// reconstruction's covariance rotated to ENU, plus the database's sigma_xy
+// and sigma_z). Along the line nothing is constrained.
 #ifndef ZEBRAGEO_ADJUSTMENT_LINE_CONTROL_H_
 #define ZEBRAGEO_ADJUSTMENT_LINE_CONTROL_H_
 
@@ -34,6 +38,8 @@ struct LineControlPoint {
   Eigen::Vector3d p_body = Eigen::Vector3d::Zero();
   Eigen::Vector3d db_point_enu = Eigen::Vector3d::Zero();
   Eigen::Vector3d across_enu = Eigen::Vector3d::UnitX();  // horizontal unit
+  Eigen::Vector3d along_enu = Eigen::Vector3d::UnitY();   // horizontal unit
+  double grade = 0.0;  // of the database segment: dz per horizontal metre
   // Whitening of [across, up] (2 x 2, lower triangular).
   Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
 };
@@ -71,9 +77,11 @@ class LinePointError {
     }
     const T across = point_.across_enu[0] * d[0] + point_.across_enu[1] * d[1] +
                      point_.across_enu[2] * d[2];
+    const T along = point_.along_enu[0] * d[0] + point_.along_enu[1] * d[1];
+    const T height = d[2] - point_.grade * along;
     const Eigen::Matrix2d& S = point_.sqrt_information;
-    residuals[0] = S(0, 0) * across + S(0, 1) * d[2];
-    residuals[1] = S(1, 0) * across + S(1, 1) * d[2];
+    residuals[0] = S(0, 0) * across + S(0, 1) * height;
+    residuals[1] = S(1, 0) * across + S(1, 1) * height;
     return true;
   }
 

@@ -17,6 +17,7 @@
 #include <unordered_map>
 
 #include "adjustment/cost_functions.h"
+#include "adjustment/vehicle_motion.h"
 
 namespace zebrageo {
 namespace {
@@ -86,6 +87,10 @@ struct State {
   std::vector<TiePoint> ties;
   // Matched road-line points with the INS pose at their time.
   std::vector<std::pair<LineControlPoint, Pose>> lines;
+  // Vehicle-motion constraints and the vehicle block (yaw misalignment,
+  // axle offset).
+  std::vector<VehicleMotionSample> motion;
+  std::array<double, kVehicleSize> vehicle{};
   // Centre of the GNSS/INS prior of each knot: 0, or the jumps removed
   // from the trajectory before the knot (track frame).
   std::vector<Eigen::Matrix<double, 6, 1>> knot_prior;
@@ -304,6 +309,8 @@ class AdjustmentProblem {
           std::make_unique<ceres::CauchyLoss>(options.control_loss_scale);
       gnss_loss_ = std::make_unique<ceres::CauchyLoss>(options.gnss_loss_scale);
       line_loss_ = std::make_unique<ceres::CauchyLoss>(options.line_loss_scale);
+      motion_loss_ = std::make_unique<ceres::CauchyLoss>(
+          options.vehicle_motion_loss_scale);
     }
     Build();
   }
@@ -336,6 +343,9 @@ class AdjustmentProblem {
       if (problem_->HasParameterBlock(r.data())) {
         ordering->AddElementToGroup(r.data(), 1);
       }
+    }
+    if (problem_->HasParameterBlock(state_->vehicle.data())) {
+      ordering->AddElementToGroup(state_->vehicle.data(), 1);
     }
     solver_options.linear_solver_ordering = ordering;
     ceres::Solver::Summary summary;
@@ -404,6 +414,7 @@ class AdjustmentProblem {
     Eigen::Matrix<double, 6, 6> S_att = Eigen::Matrix<double, 6, 6>::Zero();
     S_att.diagonal().head<3>().setConstant(
         1.0 / (options_.ins_attitude_sigma_deg * kDegToRad));
+    S_att(2, 2) /= widen;  // heading: see ins_attitude_sigma_deg
     Eigen::Matrix<double, 6, 6> S_pos = Eigen::Matrix<double, 6, 6>::Zero();
     S_pos.diagonal().tail<3>() =
         Eigen::Vector3d(1.0 / state_->gnss_sigma_m.x(),
@@ -514,6 +525,33 @@ class AdjustmentProblem {
           line_loss_.get(), knots[first].data(), knots[first + 1].data(),
           knots[first + 2].data(), knots[first + 3].data());
     }
+    AddVehicleMotion();
+  }
+
+  void AddVehicleMotion() {
+    if (state_->motion.empty()) return;
+    double* vehicle = state_->vehicle.data();
+    problem_->AddParameterBlock(vehicle, kVehicleSize);
+    ++num_pose_blocks_;
+    const double misalignment =
+        1.0 / (options_.vehicle_misalignment_sigma_deg * kDegToRad);
+    const Eigen::Matrix3d S =
+        Eigen::Vector3d(misalignment, 1.0 / options_.axle_offset_sigma_m,
+                        misalignment)
+            .asDiagonal();
+    problem_->AddResidualBlock(LinearPrior<1, kVehicleSize>::Create(S, {1.0}),
+                               nullptr, vehicle);
+    auto& knots = state_->correction.knots();
+    for (const VehicleMotionSample& sample : state_->motion) {
+      VehicleMotionCost* cost =
+          VehicleMotionCost::Create(sample, state_->correction);
+      std::vector<double*> blocks;
+      for (int k = 0; k < cost->num_knots(); ++k) {
+        blocks.push_back(knots[cost->first_knot() + k].data());
+      }
+      blocks.push_back(vehicle);
+      problem_->AddResidualBlock(cost, motion_loss_.get(), blocks);
+    }
   }
 
   const AdjustmentOptions& options_;
@@ -524,6 +562,7 @@ class AdjustmentProblem {
   std::unique_ptr<ceres::LossFunction> control_loss_;
   std::unique_ptr<ceres::LossFunction> gnss_loss_;
   std::unique_ptr<ceres::LossFunction> line_loss_;
+  std::unique_ptr<ceres::LossFunction> motion_loss_;
   Blocks blocks_;
   int num_pose_blocks_ = 0;
 };
@@ -726,11 +765,25 @@ std::string AdjustmentOptions::Check() const {
       {"line_loss_scale", line_loss_scale},
       {"boresight_sigma_deg", boresight_sigma_deg},
       {"lever_arm_sigma_m", lever_arm_sigma_m},
+      {"vertical_slip_sigma_deg", vertical_slip_sigma_deg},
+      {"vehicle_motion_rate_hz", vehicle_motion_rate_hz},
+      {"vehicle_motion_half_chord_s", vehicle_motion_half_chord_s},
+      {"vehicle_misalignment_sigma_deg", vehicle_misalignment_sigma_deg},
+      {"axle_offset_sigma_m", axle_offset_sigma_m},
+      {"vehicle_motion_loss_scale", vehicle_motion_loss_scale},
   };
   for (const Positive& p : positives) {
     if (!(p.value > 0.0) || !std::isfinite(p.value)) {
       return Violation(p.name, p.value, "must be finite and > 0");
     }
+  }
+  if (!(sideslip_sigma_deg >= 0.0) || !std::isfinite(sideslip_sigma_deg)) {
+    return Violation("sideslip_sigma_deg", sideslip_sigma_deg,
+                     "must be finite and >= 0 (0 disables)");
+  }
+  if (!(vehicle_motion_min_speed_mps >= 0.0)) {
+    return Violation("vehicle_motion_min_speed_mps",
+                     vehicle_motion_min_speed_mps, "must be >= 0");
   }
   if (!(crossing_offset_sigma_m >= 0.0)) {
     return Violation("crossing_offset_sigma_m", crossing_offset_sigma_m,
@@ -993,6 +1046,35 @@ AdjustmentResult AdjustTrajectory(
       state.knot_prior.push_back(b);
     }
   }
+  if (options.sideslip_sigma_deg > 0.0) {
+    std::vector<double> sample_times;
+    sample_times.reserve(trajectory.size());
+    for (const TrajectorySample& sample : trajectory.samples()) {
+      sample_times.push_back(sample.time);
+    }
+    state.motion = MakeVehicleMotionSamples(
+        state.correction, sample_times, options.vehicle_motion_rate_hz,
+        options.vehicle_motion_half_chord_s,
+        options.vehicle_motion_min_speed_mps,
+        Eigen::Vector2d(options.sideslip_sigma_deg,
+                        options.vertical_slip_sigma_deg) *
+            kDegToRad,
+        ins_pose_at);
+  }
+  summary.num_vehicle_motion = static_cast<int>(state.motion.size());
+  // RMS angles (lateral, vertical) left unexplained, degrees.
+  auto crab_rms_deg = [&state]() {
+    std::vector<double> lateral, vertical;
+    for (const VehicleMotionSample& sample : state.motion) {
+      const Eigen::Vector2d crab =
+          CrabAngleResidual(sample, state.correction, state.vehicle.data()) /
+          kDegToRad;
+      lateral.push_back(crab.x());
+      vertical.push_back(crab.y());
+    }
+    return Eigen::Vector2d(Rms(lateral), Rms(vertical));
+  };
+  const Eigen::Vector2d crab_before_deg = crab_rms_deg();
 
   int num_control = 0;
   for (const ControlPoint& p : state.points) {
@@ -1033,6 +1115,7 @@ AdjustmentResult AdjustTrajectory(
     for (Knot& k : state.correction.knots()) k.fill(0.0);
     for (Eigen::Vector3d& o : state.crossing_offsets) o.setZero();
     for (ControlPoint& p : state.points) p.estimate = p.database_enu;
+    state.vehicle.fill(0.0);
   };
   // The adjustment with its blunder loop; false (summary.message set) when
   // it fails.
@@ -1410,6 +1493,37 @@ AdjustmentResult AdjustTrajectory(
   if (!state.ties.empty()) {
     summary.rms.push_back(
         {"tie_image", "px", after.tie_images, before.tie_px, after.tie_px});
+  }
+  if (!state.motion.empty()) {
+    const Eigen::Vector2d crab_after_deg = crab_rms_deg();
+    summary.rms.push_back({"vehicle_lateral_slip", "deg",
+                           summary.num_vehicle_motion, crab_before_deg.x(),
+                           crab_after_deg.x()});
+    summary.rms.push_back({"vehicle_vertical_slip", "deg",
+                           summary.num_vehicle_motion, crab_before_deg.y(),
+                           crab_after_deg.y()});
+    summary.vehicle_yaw_misalignment_deg = state.vehicle[0] / kDegToRad;
+    summary.vehicle_axle_offset_m = state.vehicle[1];
+    summary.vehicle_pitch_misalignment_deg = state.vehicle[2] / kDegToRad;
+    LOG(INFO) << "adjustment: vehicle motion over "
+              << summary.num_vehicle_motion << " constraints: lateral slip "
+              << crab_before_deg.x() << " -> " << crab_after_deg.x()
+              << " deg RMS, vertical " << crab_before_deg.y() << " -> "
+              << crab_after_deg.y() << "; INS misalignment yaw "
+              << summary.vehicle_yaw_misalignment_deg << " deg, pitch "
+              << summary.vehicle_pitch_misalignment_deg << " deg, axle offset "
+              << summary.vehicle_axle_offset_m << " m";
+    if (crab_after_deg.x() > 3.0 * options.sideslip_sigma_deg ||
+        crab_after_deg.y() > 3.0 * options.vertical_slip_sigma_deg) {
+      warn(
+          "the vehicle's direction of travel departs from its corrected "
+          "attitude by " +
+          std::to_string(crab_after_deg.x()) + " deg RMS laterally, " +
+          std::to_string(crab_after_deg.y()) +
+          " deg vertically, more than 3 x sideslip_sigma_deg or "
+          "vertical_slip_sigma_deg: the vehicle-motion constraint does not "
+          "fit this vehicle (set them wider, or 0 to disable it)");
+    }
   }
   summary.rms.push_back({"trajectory_correction_horizontal", "m",
                          trajectory.size(), 0.0,

@@ -20,6 +20,8 @@
 //     control first (variance components: what the crossings' discrepancies
 //     hold beyond the database's own error), so a drift smaller than the
 //     database's error is not "corrected" into that error;
+//   - the vehicle's motion: it moves along its heading (vehicle_motion.h),
+//     sigma sideslip_sigma_deg per constraint, Cauchy loss;
 //   - the INS relative motion: the drift rate (first difference of knots,
 //     at most what a Gauss-Markov drift of sigma gnss_* and correlation
 //     time prior_correlation_time_s allows) and its change (second
@@ -76,8 +78,12 @@ struct AdjustmentOptions {
   // that error (an adjustment must not make the trajectory worse).
   bool estimate_gnss_sigma = true;
   double min_gnss_sigma_m = 0.03;
-  // The INS absolute attitude, per knot (heading and tilt drift of a
-  // tactical-grade INS: a few hundredths of a degree to a tenth).
+  // The INS absolute attitude (heading and tilt drift of a tactical-grade
+  // INS: a few hundredths of a degree to a tenth). Tilt per knot (gravity
+  // holds it); heading, like the position, once per
+  // prior_correlation_time_s: its drift is slow, and counting it per knot
+  // would hold the heading to the INS's where only the vehicle's motion
+  // and road lines control it.
   double ins_attitude_sigma_deg = 0.2;
   // Correlation time of the GNSS/INS error (its drift): the two priors
   // above hold once per this time, so each knot's prior is widened by
@@ -141,6 +147,31 @@ struct AdjustmentOptions {
   double line_loss_scale = 3.0;
   // ---------------------------------------------------- tie points
   double tie_sigma_px = 1.0;
+
+  // ---------------------------------------------------- vehicle motion
+  // The non-holonomic constraint (vehicle_motion.h): the vehicle moves
+  // along its heading, so the direction of travel of the corrected
+  // positions holds the heading where only they are controlled (between
+  // and beyond crossings, along road lines), and their height the pitch.
+  // sideslip_sigma_deg, vertical_slip_sigma_deg: the spread of the angle
+  // between the velocity and the body's x axis (lateral, vertical) from the
+  // body's oscillations, per constraint (they average out over a second or
+  // two); sideslip_sigma_deg = 0 disables both.
+  double sideslip_sigma_deg = 0.1;
+  double vertical_slip_sigma_deg = 0.35;
+  double vehicle_motion_rate_hz = 10.0;
+  // Half-length of the chord giving the velocity (at least; the chord
+  // joins trajectory samples).
+  double vehicle_motion_half_chord_s = 0.05;
+  // Below this speed the direction of travel is not used.
+  double vehicle_motion_min_speed_mps = 2.0;
+  // Priors of the vehicle block: the INS's yaw and pitch misalignment to
+  // the vehicle's axis, and its distance ahead of the axle that does not
+  // slip.
+  double vehicle_misalignment_sigma_deg = 1.0;
+  double axle_offset_sigma_m = 3.0;
+  // Cauchy loss on the constraint, in sigmas (a skid, a wrong sample).
+  double vehicle_motion_loss_scale = 3.0;
 
   // ---------------------------------------------------- rig calibration
   // Estimate each camera's boresight rotation and lever arm (shared by all
@@ -256,6 +287,12 @@ struct AdjustmentSummary {
   double max_correction_horizontal_m = 0.0;
   double max_correction_vertical_m = 0.0;
   double rms_correction_horizontal_m = 0.0;
+  // Vehicle-motion constraint: number of constraints, the estimated INS
+  // yaw and pitch misalignment and axle offset.
+  int num_vehicle_motion = 0;
+  double vehicle_yaw_misalignment_deg = 0.0;
+  double vehicle_pitch_misalignment_deg = 0.0;
+  double vehicle_axle_offset_m = 0.0;
   // Jumps found in the input trajectory (GNSS returns).
   int num_jumps = 0;
   // Posterior sd of the corrected positions (median over the samples, 0

@@ -109,6 +109,35 @@ std::string LineMatchOptions::Check() const {
   return error.empty() ? error : "line matching options: " + error;
 }
 
+double DatabaseLineGrade(const DatabaseLineEnu& line, int segment, double t,
+                         double half_window_m) {
+  const std::vector<Eigen::Vector3d>& p = line.points;
+  const int n = static_cast<int>(p.size());
+  if (segment < 0 || segment + 1 >= n) return 0.0;
+  // Horizontal arc length of each vertex.
+  std::vector<double> arc(n, 0.0);
+  for (int i = 1; i < n; ++i) {
+    arc[i] = arc[i - 1] + (p[i] - p[i - 1]).head<2>().norm();
+  }
+  const double at = arc[segment] + t * (arc[segment + 1] - arc[segment]);
+  double sw = 0.0, ss = 0.0, sz = 0.0, sss = 0.0, ssz = 0.0;
+  for (int i = 0; i < n; ++i) {
+    if (std::abs(arc[i] - at) > half_window_m) continue;
+    const double s_i = arc[i] - at;
+    sw += 1.0;
+    ss += s_i;
+    sz += p[i].z();
+    sss += s_i * s_i;
+    ssz += s_i * p[i].z();
+  }
+  const double denominator = sw * sss - ss * ss;
+  if (sw >= 3.0 && denominator > 1e-9) {
+    return (sw * ssz - ss * sz) / denominator;
+  }
+  const double run = arc[segment + 1] - arc[segment];
+  return run > 1e-6 ? (p[segment + 1].z() - p[segment].z()) / run : 0.0;
+}
+
 std::vector<DatabaseLineEnu> DatabaseLinesEnu(const RoadmarkDatabase& database,
                                               const LocalFrame& frame) {
   std::vector<DatabaseLineEnu> out;
@@ -195,6 +224,7 @@ std::vector<LinePointMatch> MatchLinePoints(
       m.point = static_cast<int>(i);
       m.db_line = best.line;
       m.db_segment = best.segment;
+      m.db_segment_t = best.t;
       m.db_point_enu = a + best.t * (b - a);
       m.along_enu = along;
       m.across_enu = Eigen::Vector3d(-along.y(), along.x(), 0.0);

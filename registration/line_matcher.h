@@ -55,6 +55,15 @@ struct DatabaseLineEnu {
 std::vector<DatabaseLineEnu> DatabaseLinesEnu(const RoadmarkDatabase& database,
                                               const LocalFrame& frame);
 
+// The slope (dz per horizontal metre, in the direction of the line's
+// points) of a database line at a point of one of its segments (fraction
+// t in [0, 1]): the least-squares slope of its vertices within
+// half_window_m (horizontal, along the line) of that point, so one vertex's
+// height noise does not make a short segment steep; the segment's own
+// slope when fewer than 3 vertices are that close.
+double DatabaseLineGrade(const DatabaseLineEnu& line, int segment, double t,
+                         double half_window_m);
+
 // One reconstructed line point in ENU.
 struct LinePointEnu {
   int64_t line_id = 0;  // points of one line share it, consecutive
@@ -63,9 +72,10 @@ struct LinePointEnu {
 };
 
 struct LinePointMatch {
-  int point = 0;       // index into the points
-  int db_line = 0;     // index into the database lines
-  int db_segment = 0;  // its segment (points[db_segment], points[+1])
+  int point = 0;              // index into the points
+  int db_line = 0;            // index into the database lines
+  int db_segment = 0;         // its segment (points[db_segment], points[+1])
+  double db_segment_t = 0.0;  // where on it, [0, 1]
   // The matched database segment's point nearest (horizontally) to the
   // reconstructed point, and the directions the match constrains.
   Eigen::Vector3d db_point_enu = Eigen::Vector3d::Zero();

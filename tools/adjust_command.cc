@@ -25,6 +25,7 @@ struct AdjustArguments {
   bool self_calibrate = false;
   double check_share = AdjustmentOptions().check_crossing_share;
   int threads = AdjustmentOptions().solver.num_threads;
+  double sideslip_sigma_deg = AdjustmentOptions().sideslip_sigma_deg;
 };
 
 void RunAdjust(const AdjustArguments& args) {
@@ -32,6 +33,7 @@ void RunAdjust(const AdjustArguments& args) {
   options.check_crossing_share = args.check_share;
   options.self_calibrate_rig = args.self_calibrate;
   options.solver.num_threads = args.threads;
+  options.sideslip_sigma_deg = args.sideslip_sigma_deg;
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
   RunAdjustStage(args.stage.survey, args.stage.results, options,
@@ -108,6 +110,7 @@ void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands) {
       ->capture_default_str();
   sub->add_option("--threads", args->threads, "solver threads")
       ->capture_default_str();
+  AddSideslipOption(sub, &args->sideslip_sigma_deg);
   commands->push_back({sub, [args] { RunAdjust(*args); }});
 }
 

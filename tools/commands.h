@@ -36,6 +36,8 @@ struct StageArguments {
 CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
                              const std::string& description,
                              StageArguments* args);
+// --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_deg).
+void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg);
 // A runner for a stage that is not built yet: it validates the survey (so
 // the user learns whether it is readable), then throws NotImplementedError.
 std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,

@@ -26,6 +26,10 @@
 namespace zebrageo {
 namespace {
 
+// The database line's slope is fitted over +-10 m: the height of a control
+// point follows it when the adjustment moves the point along the line.
+constexpr double kGradeHalfWindowM = 10.0;
+
 // The corrected body pose at `time` (linear in position, slerp in
 // attitude between the corrected samples); false outside them.
 bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
@@ -205,6 +209,9 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     c.p_body = p.p_body;
     c.db_point_enu = m.db_point_enu;
     c.across_enu = m.across_enu;
+    c.along_enu = m.along_enu;
+    c.grade = DatabaseLineGrade(line, m.db_segment, m.db_segment_t,
+                                kGradeHalfWindowM);
     c.sqrt_information = LineSqrtInformation(
         p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
         shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),

@@ -25,6 +25,7 @@ struct RunArguments {
   int threads = 0;
   bool tie_points = true;
   bool lines = true;  // road lines as control beside the zebras (issue 9)
+  double sideslip_sigma_deg = AdjustmentOptions().sideslip_sigma_deg;
 };
 
 double PeakMemoryMb() {
@@ -55,6 +56,7 @@ void Run(const RunArguments& args) {
   MatchOptions matching;
   AdjustmentOptions adjustment;
   if (args.threads > 0) adjustment.solver.num_threads = args.threads;
+  adjustment.sideslip_sigma_deg = args.sideslip_sigma_deg;
   for (const std::string& problem :
        {reconstruction.Check(), matching.Check(), adjustment.Check()}) {
     if (!problem.empty()) throw UsageError(problem);
@@ -100,7 +102,8 @@ void Run(const RunArguments& args) {
                     }});
   std::ostringstream settings;
   settings << "threads-independent;ties=" << args.tie_points
-           << ";lines=" << args.lines;
+           << ";lines=" << args.lines
+           << ";sideslip=" << args.sideslip_sigma_deg;
   const PipelineRun run = RunPipeline(
       results, InputFingerprint(SurveyInputFiles(survey), settings.str()),
       stages, PipelineOptions{args.from_stage});
@@ -137,6 +140,7 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
                 "do not match image features between exposures");
   run->add_flag("!--no-lines", run_args->lines,
                 "zebra crossings alone as control: no road lines");
+  AddSideslipOption(run, &run_args->sideslip_sigma_deg);
   commands->push_back({run, [run_args] { Run(*run_args); }});
 
   auto report_args = std::make_shared<StageArguments>();

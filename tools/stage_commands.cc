@@ -17,6 +17,16 @@ CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
   return sub;
 }
 
+void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg) {
+  subcommand
+      ->add_option("--sideslip-sigma", *sideslip_sigma_deg,
+                   "degrees: how far the vehicle's direction of travel may "
+                   "depart from its heading (body oscillations); it holds "
+                   "the heading between crossings. 0: not used")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+}
+
 std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,
                                           const std::string& stage,
                                           const std::string& issue) {

@@ -76,6 +76,20 @@ TEST_F(LinePointErrorTest, AcrossAndHeightInSigmas) {
   EXPECT_NEAR(Residual(c)[0], 0.008 / 0.02, 1e-3);
 }
 
+TEST_F(LinePointErrorTest, HeightFollowsTheLineGradeAlongIt) {
+  // The line climbs 3 % eastwards; the INS put the point at D, the
+  // correction moves it 1 m east (along the line) and 3 cm up: on the line.
+  point_.along_enu = Eigen::Vector3d::UnitX();
+  point_.grade = 0.03;
+  Eigen::Matrix<double, 6, 1> c = Eigen::Matrix<double, 6, 1>::Zero();
+  c[3] = 1.0;
+  c[5] = 0.03;
+  EXPECT_NEAR(Residual(c).norm(), 0.0, 1e-12);
+  // Without the grade the same correction is 1 sigma too high.
+  point_.grade = 0.0;
+  EXPECT_NEAR(Residual(c)[1], 1.0, 1e-9);
+}
+
 TEST_F(LinePointErrorTest, SplineCostChainsToTheKnots) {
   const double w[4] = {0.1, 0.4, 0.4, 0.1};
   std::unique_ptr<ceres::CostFunction> cost(

@@ -118,6 +118,27 @@ SeenStreet SeeStreet(const Eigen::Vector3d& drift, double moved_m) {
   return seen;
 }
 
+TEST(DatabaseLineGrade, FitsTheSlopeOverTheWindowNotOneSegment) {
+  // A line climbing 2 % eastwards, vertices every 2.5 m with +-3 cm of
+  // height noise (alternating): one 2.5 m segment alone reads +-2.4 %.
+  DatabaseLineEnu line;
+  for (int i = 0; i <= 16; ++i) {
+    const double x = 2.5 * i;
+    line.points.emplace_back(x, 0.0, 0.02 * x + (i % 2 == 0 ? 0.03 : -0.03));
+  }
+  const double segment_slope = (line.points[5].z() - line.points[4].z()) / 2.5;
+  EXPECT_GT(std::abs(segment_slope - 0.02), 0.02);
+  EXPECT_NEAR(DatabaseLineGrade(line, 4, 0.5, 10.0), 0.02, 0.002);
+  // Walking the line the other way reverses the slope.
+  std::reverse(line.points.begin(), line.points.end());
+  EXPECT_NEAR(DatabaseLineGrade(line, 11, 0.5, 10.0), -0.02, 0.002);
+  // A two-vertex dash: the segment's own slope.
+  DatabaseLineEnu dash;
+  dash.points = {Eigen::Vector3d(0, 0, 1.0), Eigen::Vector3d(3, 0, 1.06)};
+  EXPECT_NEAR(DatabaseLineGrade(dash, 0, 0.3, 10.0), 0.02, 1e-12);
+  EXPECT_EQ(DatabaseLineGrade(dash, 1, 0.3, 10.0), 0.0);  // no such segment
+}
+
 TEST(RejectInconsistentLines, RejectsALineRepaintedSinceTheDatabase) {
   const auto db = Street();
   const SeenStreet seen = SeeStreet(Eigen::Vector3d(0.4, -0.25, 0.1), 0.3);
