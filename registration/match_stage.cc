@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <tuple>
 #include <utility>
 
@@ -402,6 +404,195 @@ MatchResult RunMatchStage(const Survey& survey,
       input, result, survey.frame,
       (fs::path(results_folder) / kMatchesGeoJsonFile).string());
   return result;
+}
+
+std::string RematchOptions::Check() const {
+  if (min_control_crossings < 1) {
+    return "min_control_crossings = " + std::to_string(min_control_crossings) +
+           ": must be >= 1";
+  }
+  if (!(gate_m > 0.0) || !std::isfinite(gate_m)) {
+    return "gate_m = " + std::to_string(gate_m) + ": must be finite and > 0";
+  }
+  if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
+    return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
+           ": must be finite and > 0";
+  }
+  if (!(max_heading_error_rad > 0.0) || !(max_heading_error_rad < 0.5)) {
+    return "max_heading_error_rad = " + std::to_string(max_heading_error_rad) +
+           ": must be in (0, 0.5)";
+  }
+  return "";
+}
+
+namespace {
+
+// The adjustment's summary (adjustment/adjustment_io.h writes it): whether
+// trajectory_corrected.csv carries posterior sd.
+constexpr char kAdjustmentSummaryFile[] = "adjustment.json";
+
+// "" when the adjustment can gate the second pass, else why not.
+std::string AdjustmentUnfitForRematch(const std::string& results_folder,
+                                      int min_control_crossings) {
+  std::ifstream in(fs::path(results_folder) / kAdjustmentSummaryFile);
+  if (!in) return std::string(kAdjustmentSummaryFile) + " is missing";
+  const json j = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object()) {
+    return std::string(kAdjustmentSummaryFile) + " is not readable JSON";
+  }
+  const json sd = j.value("posterior_sd_m", json::object());
+  if (!sd.is_object() || !sd.value("computed", false)) {
+    return "the adjustment has no posterior covariance to gate it";
+  }
+  const json counts = j.value("counts", json::object());
+  const int crossings = counts.is_object()
+                            ? counts.value("control_crossings", 0) +
+                                  counts.value("check_crossings", 0)
+                            : 0;
+  if (crossings < min_control_crossings) {
+    return "the adjustment has " + std::to_string(crossings) +
+           " control crossings (" + std::to_string(min_control_crossings) +
+           " needed to trust its error model)";
+  }
+  return "";
+}
+
+}  // namespace
+
+RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
+                                             const std::string& results_folder,
+                                             const MatchOptions& options,
+                                             const RematchOptions& rematch) {
+  RematchSummary summary;
+  const fs::path folder(results_folder);
+  const std::string unfit =
+      AdjustmentUnfitForRematch(results_folder, rematch.min_control_crossings);
+  if (!unfit.empty()) {
+    summary.message = "second registration pass skipped: " + unfit;
+    return summary;
+  }
+  const std::vector<CrossingDecision> first = ReadCrossingDecisions(
+      (folder / kCrossingDecisionsFile).string(), kCrossingDecisionsFile);
+  std::vector<VertexMatch> matches =
+      ReadMatches((folder / kMatchesFile).string(), kMatchesFile);
+  std::map<std::pair<int64_t, int64_t>, const CrossingDecision*> decided;
+  for (const CrossingDecision& d : first) {
+    decided[{d.exposure_id, d.group_id}] = &d;
+    summary.observations += d.decision != Decision::kMatched;
+  }
+  if (summary.observations == 0) {
+    summary.message = "second registration pass: nothing left undecided";
+    return summary;
+  }
+
+  // The survey as the adjustment left it.
+  Survey adjusted = survey;
+  adjusted.trajectory = Trajectory(
+      ReadTrajectorySamples((folder / kTrajectoryCorrectedFile).string(),
+                            kTrajectoryCorrectedFile),
+      survey.frame);
+  const std::vector<ReconstructedVertex> vertices = ReadReconstructedBands(
+      (folder / kReconstructedBandsFile).string(), kReconstructedBandsFile);
+  MatchInput input;
+  input.observations =
+      BuildObservations(adjusted, vertices, kReconstructedBandsFile, nullptr);
+  input.exposures = ExposurePoses(adjusted);
+  const RoadmarkIndex index(adjusted.roadmarks, adjusted.frame);
+  input.index = &index;
+  input.rig = &adjusted.rig;
+  ImagePaintProbe probe(adjusted);
+  input.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
+                               const BandCornersEnu& band,
+                               const std::vector<BandCornersEnu>& seen) {
+    return probe.Classify(exposure_id, pose, band, seen);
+  };
+  MatchOptions tight = options;
+  tight.max_drift_m = rematch.gate_m;
+  tight.sd_gate_factor = rematch.sd_gate_factor;
+  tight.max_heading_error_rad = rematch.max_heading_error_rad;
+  const MatchResult second = MatchBands(input, tight);
+  if (!second.summary.IsUsable()) {
+    summary.message =
+        "second registration pass failed: " + second.summary.message;
+    return summary;
+  }
+
+  // What the first pass matched must come out the same.
+  std::map<std::tuple<int64_t, int64_t, int>, const VertexMatch*> first_match;
+  for (const VertexMatch& m : matches) {
+    first_match[{m.exposure_id, m.band_id, m.vertex}] = &m;
+  }
+  std::map<std::pair<int64_t, int64_t>, std::vector<const VertexMatch*>>
+      second_of_exposure;
+  for (const VertexMatch& m : second.matches) {
+    const auto f = first_match.find({m.exposure_id, m.band_id, m.vertex});
+    if (f != first_match.end() &&
+        (f->second->crossing_id != m.crossing_id || f->second->band != m.band ||
+         f->second->db_vertex != m.db_vertex)) {
+      ++summary.disagreements;
+    }
+  }
+  if (summary.disagreements > 0) {
+    summary.message =
+        "second registration pass not used: with the adjusted trajectory " +
+        std::to_string(summary.disagreements) +
+        " vertex matches of the first pass come out differently";
+    LOG(WARNING) << summary.message;
+    return summary;
+  }
+
+  // Band ids of each observation, to take its matches.
+  std::map<std::pair<int64_t, int64_t>, std::set<int64_t>> bands_of;
+  for (const CrossingObservation& o : input.observations) {
+    for (const ObservedBand& b : o.bands) {
+      bands_of[{o.exposure_id, o.group_id}].insert(b.band_id);
+    }
+  }
+  std::vector<CrossingDecision> merged = first;
+  for (CrossingDecision& d : merged) {
+    if (d.decision == Decision::kMatched) continue;
+    const auto it = std::find_if(
+        second.decisions.begin(), second.decisions.end(),
+        [&](const CrossingDecision& s) {
+          return s.exposure_id == d.exposure_id && s.group_id == d.group_id;
+        });
+    if (it == second.decisions.end() || it->decision != Decision::kMatched) {
+      continue;
+    }
+    const std::set<int64_t>& bands = bands_of[{d.exposure_id, d.group_id}];
+    int added_vertices = 0;
+    for (const VertexMatch& m : second.matches) {
+      if (m.exposure_id == d.exposure_id && bands.count(m.band_id)) {
+        matches.push_back(m);
+        ++added_vertices;
+      }
+    }
+    if (added_vertices == 0) continue;
+    d.decision = Decision::kMatched;
+    d.crossing_id = it->crossing_id;
+    d.reason = "matched with the adjusted trajectory (second pass; gate " +
+               std::to_string(rematch.gate_m).substr(0, 4) +
+               " m or 5 posterior sd): " + it->reason +
+               "; first pass: " + d.reason;
+    ++summary.added;
+  }
+  std::ostringstream message;
+  message << "second registration pass with the adjusted trajectory: "
+          << summary.added << " of " << summary.observations
+          << " undecided observations matched";
+  summary.message = message.str();
+  if (summary.added == 0) return summary;
+  std::sort(matches.begin(), matches.end(),
+            [](const VertexMatch& a, const VertexMatch& b) {
+              return std::tie(a.exposure_id, a.band_id, a.vertex) <
+                     std::tie(b.exposure_id, b.band_id, b.vertex);
+            });
+  const std::vector<std::string> comments = {"zebrageo run: " +
+                                             summary.message};
+  WriteMatches(matches, comments, (folder / kMatchesFile).string());
+  WriteCrossingDecisions(merged, comments,
+                         (folder / kCrossingDecisionsFile).string());
+  return summary;
 }
 
 }  // namespace zebrageo

@@ -56,6 +56,41 @@ MatchResult RunMatchStage(const Survey& survey,
                           const MatchOptions& options,
                           const std::function<void(int, int)>& progress = {});
 
+// The second registration pass of `zebrageo run`: the observations the first
+// pass left undecided (refused as ambiguous, no candidate) are matched again
+// with the ADJUSTED trajectory (RESULTS/trajectory_corrected.csv). Where the
+// adjustment controls it (road lines hold the cross-track position between
+// crossings, and a crossing's 1 m band period runs across the road), its
+// error is centimetres, not the metres the first pass had to allow: the
+// candidate gate shrinks to gate_m, or sd_gate_factor times the
+// adjustment's posterior sd where that is larger, and a one-band shift is no
+// longer a candidate. An observation the first pass matched is never
+// changed; if the second pass disagrees with any of them, the adjusted
+// trajectory is not trusted and nothing is added. Nothing is done without a
+// posterior covariance (adjustment.json; the sd would be the input's
+// optimistic one) or with fewer than min_control_crossings crossings in the
+// adjustment (its GNSS/INS error model is estimated from them: without
+// them the posterior sd is not the trajectory's error).
+struct RematchOptions {
+  int min_control_crossings = 3;
+  double gate_m = 0.25;
+  double sd_gate_factor = 5.0;
+  double max_heading_error_rad = 0.005;
+  std::string Check() const;
+};
+struct RematchSummary {
+  int observations = 0;   // undecided after the first pass
+  int added = 0;          // matched now
+  int disagreements = 0;  // first-pass matches the second pass contradicts
+  std::string message;    // one line for the log and the report
+};
+// Rewrites matches.csv and crossing_decisions.csv (atomically) when it adds
+// matches. Throws InputError for unreadable inputs.
+RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
+                                             const std::string& results_folder,
+                                             const MatchOptions& options,
+                                             const RematchOptions& rematch);
+
 }  // namespace zebrageo
 
 #endif  // ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_

@@ -1,6 +1,8 @@
 // `zebrageo match SURVEY -o RESULTS`: reads RESULTS/reconstructed_bands.csv,
 // writes matches.csv, crossing_decisions.csv, match_evidence.json and
-// matches.geojson (registration/match_stage.h).
+// matches.geojson (registration/match_stage.h). With --second-pass, after
+// `zebrageo adjust`: matches what the first pass left undecided with the
+// adjusted trajectory (what `zebrageo run` does, then adjusts again).
 #include <glog/logging.h>
 
 #include <iostream>
@@ -17,6 +19,7 @@ namespace zebrageo {
 void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
   auto args = std::make_shared<StageArguments>();
   auto options = std::make_shared<MatchOptions>();
+  auto second_pass = std::make_shared<bool>(false);
   CLI::App* sub = AddStageSubcommand(
       app, "match",
       "Match reconstructed bands to the road-mark database; writes "
@@ -47,21 +50,32 @@ void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
                 "agree (immune to a database fault at one end)");
   sub->add_flag("--refuse-shifted-crossings", options->refuse_shifted_crossings,
                 "refuse matches to database crossings that look shifted");
-  commands->push_back({sub, [args, options] {
-                         const std::string problem = options->Check();
-                         if (!problem.empty()) {
-                           throw UsageError("match: " + problem);
-                         }
-                         const Survey survey = LoadSurvey(args->survey);
-                         ProgressBar bar("match");
-                         const MatchResult result = RunMatchStage(
-                             survey, args->results, *options, bar.Callback());
-                         bar.Finish();
-                         if (!result.summary.IsUsable()) {
-                           throw StageFailedError(result.summary.message);
-                         }
-                         std::cout << result.summary.BriefReport() << "\n";
-                       }});
+  sub->add_flag("--second-pass", *second_pass,
+                "after `zebrageo adjust`: match the observations the first "
+                "pass left undecided with RESULTS/trajectory_corrected.csv "
+                "(rewrites matches.csv and crossing_decisions.csv)");
+  commands->push_back(
+      {sub, [args, options, second_pass] {
+         const std::string problem = options->Check();
+         if (!problem.empty()) {
+           throw UsageError("match: " + problem);
+         }
+         const Survey survey = LoadSurvey(args->survey);
+         if (*second_pass) {
+           const RematchSummary summary = RematchWithAdjustedTrajectory(
+               survey, args->results, *options, RematchOptions());
+           std::cout << summary.message << "\n";
+           return;
+         }
+         ProgressBar bar("match");
+         const MatchResult result =
+             RunMatchStage(survey, args->results, *options, bar.Callback());
+         bar.Finish();
+         if (!result.summary.IsUsable()) {
+           throw StageFailedError(result.summary.message);
+         }
+         std::cout << result.summary.BriefReport() << "\n";
+       }});
 }
 
 }  // namespace zebrageo

@@ -26,6 +26,8 @@ struct RunArguments {
   bool tie_points = true;
   bool lines = true;  // road lines as control beside the zebras (issue 9)
   double sideslip_sigma_deg = AdjustmentOptions().sideslip_sigma_deg;
+  // Second registration pass with the adjusted trajectory.
+  bool rematch = true;
 };
 
 double PeakMemoryMb() {
@@ -97,13 +99,25 @@ void Run(const RunArguments& args) {
                     {kTrajectoryCorrectedFile, kPosesFile, kGcpResidualsFile,
                      kBandsGeoJsonFile},
                     [&](const std::function<void(int, int)>&) {
+                      std::vector<std::string> warnings =
+                          RunAdjustStage(survey.folder, results, adjustment,
+                                         args.tie_points, args.lines);
+                      if (!args.rematch) return warnings;
+                      // Crossings the first pass could not decide, matched
+                      // again with the adjusted trajectory; if any is
+                      // added, the adjustment is made again with them.
+                      const RematchSummary rematch =
+                          RematchWithAdjustedTrajectory(
+                              survey, results, matching, RematchOptions());
+                      LOG(INFO) << rematch.message;
+                      if (rematch.added == 0) return warnings;
                       return RunAdjustStage(survey.folder, results, adjustment,
                                             args.tie_points, args.lines);
                     }});
   std::ostringstream settings;
   settings << "threads-independent;ties=" << args.tie_points
-           << ";lines=" << args.lines
-           << ";sideslip=" << args.sideslip_sigma_deg;
+           << ";lines=" << args.lines << ";sideslip=" << args.sideslip_sigma_deg
+           << ";rematch=" << args.rematch;
   const PipelineRun run = RunPipeline(
       results, InputFingerprint(SurveyInputFiles(survey), settings.str()),
       stages, PipelineOptions{args.from_stage});
@@ -141,6 +155,8 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
   run->add_flag("!--no-lines", run_args->lines,
                 "zebra crossings alone as control: no road lines");
   AddSideslipOption(run, &run_args->sideslip_sigma_deg);
+  run->add_flag("!--no-rematch", run_args->rematch,
+                "no second registration pass with the adjusted trajectory");
   commands->push_back({run, [run_args] { Run(*run_args); }});
 
   auto report_args = std::make_shared<StageArguments>();

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "survey/input_error.h"
@@ -164,6 +165,159 @@ TEST(MatchStage, RejectsBandsOfAnExposureTheSurveyDoesNotHave) {
     EXPECT_NE(std::string(error.what()).find("exposure_id 999999"),
               std::string::npos);
   }
+}
+
+// The "adjusted" trajectory of the second pass: the true poses shifted by
+// `shift_enu_m`, with a posterior sd of 3 cm, and an adjustment.json that
+// says the sd is posterior (`posterior` false: it is not) and how many
+// crossings controlled it.
+void WriteAdjustedTrajectory(const SyntheticScene& scene,
+                             const Eigen::Vector2d& shift_enu_m, bool posterior,
+                             const std::string& results,
+                             int control_crossings = 3) {
+  std::vector<TrajectorySample> samples;
+  for (const ExposurePose& e : scene.exposures) {
+    Pose pose = scene.true_pose.at(e.exposure_id);
+    pose.p_enu.head<2>() += shift_enu_m;
+    samples.push_back(SampleFromPose(e.time_s, pose, scene.frame,
+                                     Eigen::Vector3d::Constant(0.03),
+                                     Eigen::Vector3d::Constant(1e-4)));
+  }
+  WriteTrajectorySamples(samples, results + "/" + kTrajectoryCorrectedFile);
+  std::ofstream(results + "/adjustment.json") << nlohmann::json{
+      {"posterior_sd_m", {{"computed", posterior}}},
+      {"counts",
+       {{"control_crossings", control_crossings}}}}.dump();
+}
+
+// Three crossings whose first two bands a parked vehicle hides from every
+// viewpoint, seen from a trajectory 2 m off: an observation of interior
+// bands alone cannot tell which bands they are, so the first pass refuses
+// them; with a trajectory adjusted to centimetres they are unambiguous.
+class SecondPassTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SyntheticSceneOptions options;
+    options.seed = 8;
+    options.crossings = RandomCrossings(3, 45.0, 8);
+    for (SyntheticCrossingSpec& c : options.crossings) {
+      c.occluded_bands = 2;
+      c.occluded_beyond_m = 0.0;
+    }
+    options.miss_probability = 0.0;
+    options.false_band_probability = 0.0;
+    scene_ = MakeSyntheticScene(options);
+    WriteSceneSurvey(scene_, folder_.Path("survey"), folder_.Path("results"));
+    survey_ = LoadSurvey(folder_.Path("survey"));
+    first_ = RunMatchStage(survey_, folder_.Path("results"), MatchOptions());
+    ASSERT_TRUE(first_.summary.IsUsable());
+  }
+  std::vector<VertexMatch> Matches() const {
+    return ReadMatches(folder_.Path("results/matches.csv"), "matches.csv");
+  }
+  int Undecided() const {
+    int n = 0;
+    for (const CrossingDecision& d : ReadCrossingDecisions(
+             folder_.Path("results/crossing_decisions.csv"), "decisions")) {
+      n += d.decision != Decision::kMatched;
+    }
+    return n;
+  }
+  TemporaryFolder folder_;
+  SyntheticScene scene_;
+  Survey survey_;
+  MatchResult first_;
+};
+
+TEST_F(SecondPassTest, MatchesWhatTheFirstPassRefusedAndNothingWrong) {
+  const int undecided = Undecided();
+  ASSERT_GT(undecided, 0) << "the scene no longer makes the first pass refuse";
+  const size_t first_matches = Matches().size();
+  EXPECT_EQ(ScoreMatches(scene_, Matches()).wrong, 0);
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(0.03, -0.02), true,
+                          folder_.Path("results"));
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_EQ(summary.observations, undecided);
+  EXPECT_GT(summary.added, 0) << summary.message;
+  EXPECT_EQ(summary.disagreements, 0);
+  EXPECT_EQ(Undecided(), undecided - summary.added);
+  const std::vector<VertexMatch> after = Matches();
+  EXPECT_GT(after.size(), first_matches);
+  EXPECT_EQ(ScoreMatches(scene_, after).wrong, 0);
+  for (const CrossingDecision& d : ReadCrossingDecisions(
+           folder_.Path("results/crossing_decisions.csv"), "decisions")) {
+    if (d.reason.find("second pass") != std::string::npos) {
+      EXPECT_EQ(d.decision, Decision::kMatched);
+    }
+  }
+}
+
+// The second pass is only as good as the adjusted trajectory: one that
+// contradicts the first pass's matches (here one band off) adds nothing.
+TEST_F(SecondPassTest, AnAdjustedTrajectoryOneBandOffIsNotTrusted) {
+  // First-pass matches on the first two crossings (the right ones, from the
+  // true trajectory), the third crossing left refused.
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d::Zero(), true,
+                          folder_.Path("results"));
+  RematchWithAdjustedTrajectory(survey_, folder_.Path("results"),
+                                MatchOptions(), RematchOptions());
+  const std::string decisions_path =
+      folder_.Path("results/crossing_decisions.csv");
+  std::vector<CrossingDecision> decisions =
+      ReadCrossingDecisions(decisions_path, "decisions");
+  std::vector<VertexMatch> matches = Matches();
+  ASSERT_EQ(ScoreMatches(scene_, matches).wrong, 0);
+  const int64_t last = decisions.back().exposure_id;
+  std::set<int64_t> refused;
+  for (CrossingDecision& d : decisions) {
+    if (d.exposure_id + 30 < last) continue;  // the last crossing's views
+    d.decision = Decision::kRefused;
+    d.crossing_id.clear();
+    refused.insert(d.exposure_id);
+  }
+  matches.erase(std::remove_if(matches.begin(), matches.end(),
+                               [&](const VertexMatch& m) {
+                                 return refused.count(m.exposure_id) > 0;
+                               }),
+                matches.end());
+  ASSERT_FALSE(matches.empty());
+  WriteCrossingDecisions(decisions, {}, decisions_path);
+  WriteMatches(matches, {}, folder_.Path("results/matches.csv"));
+  const std::vector<VertexMatch> before = Matches();
+  // One band period across the road (the bands repeat along north here).
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(0.0, 1.0), true,
+                          folder_.Path("results"));
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_GT(summary.disagreements, 0) << summary.message;
+  EXPECT_EQ(summary.added, 0);
+  EXPECT_EQ(Matches().size(), before.size());
+}
+
+TEST_F(SecondPassTest, WithoutAPosteriorSdNothingIsDone) {
+  const int undecided = Undecided();
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d::Zero(), false,
+                          folder_.Path("results"));
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_EQ(summary.added, 0);
+  EXPECT_NE(summary.message.find("skipped"), std::string::npos);
+  EXPECT_EQ(Undecided(), undecided);
+}
+
+// An adjustment with no crossing to estimate the drift from has a posterior
+// sd that says nothing of its error (seen: 8 cm for a 1 m drift).
+TEST_F(SecondPassTest, WithoutEnoughControlCrossingsNothingIsDone) {
+  const int undecided = Undecided();
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d::Zero(), true,
+                          folder_.Path("results"), 2);
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_EQ(summary.added, 0);
+  EXPECT_NE(summary.message.find("2 control crossings"), std::string::npos)
+      << summary.message;
+  EXPECT_EQ(Undecided(), undecided);
 }
 
 }  // namespace
