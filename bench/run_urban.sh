@@ -2,7 +2,8 @@
 # End-to-end timing of `zebrageo run` on the urban preset, seed 1 (issue 8:
 # under 3 minutes on 2 cores). Prints the wall and CPU time, the peak memory
 # (from the kernel and from report.json), the stage timings of report.json,
-# and the pose accuracy against truth/ when ../shared/tools is present.
+# and the reconstruction, registration and pose scores against truth/ when
+# ../shared/tools is present.
 #
 # Usage: bench/run_urban.sh [BUILD_DIR] [SURVEY] [WORK_DIR]
 #   SURVEY    an urban seed-1 survey (default: /tmp/presets/urban if present,
@@ -50,5 +51,7 @@ print(f"warnings: {len(r.get('warnings', []))}")
 PY
 scorer="$here/../shared/tools/score_results.py"
 if [[ -x /usr/bin/python3 && -f "$scorer" ]]; then
-  /usr/bin/python3 "$scorer" poses "$survey" "$results" | tail -1 || true
+  for mode in reconstruct match poses; do
+    echo "$mode: $(/usr/bin/python3 "$scorer" "$mode" "$survey" "$results" | tail -1)" || true
+  done
 fi
