@@ -284,7 +284,8 @@ std::vector<TieTrack> BuildTieTracks(
         break;
       }
       candidate.track.observations.push_back(
-          {image, info.time, info.camera, observed});
+          {image, info.time, info.camera, observed,
+           std::pow(kOrbScaleFactor, f.keypoints[k].octave)});
       candidate.exposures.push_back(exposure_index[info.exposure_id]);
     }
     if (!good) continue;

@@ -27,6 +27,9 @@ struct TieObservation {
   double time = 0.0;
   int camera = 0;  // index into Rig::cameras
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  // The feature's pyramid scale (1.2^octave): a corner found on a coarser
+  // level is localised that many times less precisely.
+  double scale = 1.0;
 };
 
 struct TieTrack {

@@ -49,7 +49,8 @@ struct ImageObservation {
   double time = 0.0;
   int camera = 0;
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
-  Pose ins_pose;  // INS pose interpolated at `time`
+  Pose ins_pose;             // INS pose interpolated at `time`
+  double sigma_scale = 1.0;  // of the observation's sigma (tie pyramid level)
 };
 
 struct ControlPoint {
@@ -511,7 +512,8 @@ class AdjustmentProblem {
     }
     for (TiePoint& t : state_->ties) {
       for (const ImageObservation& o : t.observations) {
-        AddImageResidual(o, t.estimate.data(), options_.tie_sigma_px,
+        AddImageResidual(o, t.estimate.data(),
+                         options_.tie_sigma_px * o.sigma_scale,
                          &blocks_.tie_images);
       }
     }
@@ -1010,7 +1012,7 @@ AdjustmentResult AdjustTrajectory(
             !ins_pose_at(o.time, &ins_pose)) {
           continue;
         }
-        tie.observations.push_back({o.time, o.camera, o.uv, ins_pose});
+        tie.observations.push_back({o.time, o.camera, o.uv, ins_pose, o.scale});
       }
       if (tie.observations.size() >= 2) state.ties.push_back(tie);
     }

@@ -146,6 +146,8 @@ struct AdjustmentOptions {
   // Cauchy loss on the point-to-line residuals (line_control.h), in sigmas.
   double line_loss_scale = 3.0;
   // ---------------------------------------------------- tie points
+  // Per pyramid scale of the feature (tie_points.h: 1.2^octave): a corner
+  // found on a coarser ORB level is localised that much less precisely.
   double tie_sigma_px = 1.0;
 
   // ---------------------------------------------------- vehicle motion
