@@ -186,22 +186,48 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
     }
     return m;
   };
+  // Departure of each step from its neighbours' motion.
+  std::vector<Eigen::Vector3d> position_step(n, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> rotation_step(n, Eigen::Vector3d::Zero());
+  for (int i = 1; i < n; ++i) {
+    const double dt = samples[i].time - samples[i - 1].time;
+    position_step[i] = (velocity[i] - median_of_neighbours(velocity, i)) * dt;
+    rotation_step[i] = (rate[i] - median_of_neighbours(rate, i)) * dt;
+  }
+  // A jump stands out of the trajectory's own motion: at 10 Hz the body's
+  // oscillations on its suspension (a tenth of a degree at 1-2 Hz) depart
+  // from the neighbouring steps by more than a 100 Hz trajectory's do, and
+  // are not jumps. The thresholds are raised to kJumpNoiseFactor times the
+  // median departure when that is larger.
+  constexpr double kJumpNoiseFactor = 8.0;
+  auto median_norm = [&](const std::vector<Eigen::Vector3d>& steps) {
+    std::vector<double> norms;
+    for (int i = 1; i < n; ++i) norms.push_back(steps[i].norm());
+    std::nth_element(norms.begin(), norms.begin() + norms.size() / 2,
+                     norms.end());
+    return norms[norms.size() / 2];
+  };
+  threshold_m =
+      threshold_m > 0.0
+          ? std::max(threshold_m, kJumpNoiseFactor * median_norm(position_step))
+          : 0.0;
+  threshold_rad = threshold_rad > 0.0
+                      ? std::max(threshold_rad,
+                                 kJumpNoiseFactor * median_norm(rotation_step))
+                      : 0.0;
   Eigen::Vector3d position_jump = Eigen::Vector3d::Zero();
   Eigen::Quaterniond rotation_jump = Eigen::Quaterniond::Identity();
   for (int i = 1; i < n; ++i) {
-    const double dt = samples[i].time - samples[i - 1].time;
     bool jumped = false;
     if (threshold_m > 0.0) {
-      const Eigen::Vector3d step =
-          (velocity[i] - median_of_neighbours(velocity, i)) * dt;
+      const Eigen::Vector3d& step = position_step[i];
       if (step.norm() > threshold_m) {
         position_jump += step;
         jumped = true;
       }
     }
     if (threshold_rad > 0.0) {
-      const Eigen::Vector3d step =
-          (rate[i] - median_of_neighbours(rate, i)) * dt;
+      const Eigen::Vector3d& step = rotation_step[i];
       if (step.norm() > threshold_rad) {
         // In the ENU frame: R_i = J R_i', J = R_{i-1} Exp(step) R_{i-1}^T.
         const Eigen::Quaterniond body_step(
