@@ -526,6 +526,12 @@ std::string BandOptions::Check() const {
     error << "min_line_sigma_px = " << min_line_sigma_px << ": must be > 0";
   } else if (!(min_sigma_m > 0.0)) {
     error << "min_sigma_m = " << min_sigma_m << ": must be > 0";
+  } else if (!(min_end_step_fraction >= 0.0 && min_end_step_fraction < 1.0)) {
+    error << "min_end_step_fraction = " << min_end_step_fraction
+          << ": must be in [0, 1)";
+  } else if (!(end_step_profile_px >= 1.0)) {
+    error << "end_step_profile_px = " << end_step_profile_px
+          << ": must be >= 1";
   } else if (completion_min_bands < 3) {
     error << "completion_min_bands = " << completion_min_bands
           << ": must be >= 3";
@@ -803,6 +809,34 @@ double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
     if (std::isfinite(outside)) run_on = std::max(run_on, outside / inside);
   }
   return run_on;
+}
+
+double EdgeStep(const EdgeMap& edges, const ImageLine& line,
+                const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                double half_width_px) {
+  const Eigen::Vector2d span = b - a;
+  const double length = span.norm();
+  if (!(length > 2.0)) return std::nan("");
+  const Eigen::Vector2d unit = span / length;
+  std::vector<double> steps;
+  for (double t = 0.2 * length; t <= 0.8 * length; t += 1.0) {
+    // The point of the line nearest a + t * unit.
+    const Eigen::Vector2d q = a + t * unit;
+    const Eigen::Vector2d p = q - line.Distance(q) * line.normal;
+    double step = 0.0;
+    bool usable = true;
+    for (double u = -half_width_px; u <= half_width_px && usable; u += 1.0) {
+      const Eigen::Vector2d x = p + u * line.normal;
+      usable = edges.IsUsable(x.x(), x.y());
+      const cv::Vec2f g = edges.GradientAt(x.x(), x.y());
+      step += line.normal.x() * g[0] + line.normal.y() * g[1];
+    }
+    if (usable) steps.push_back(std::abs(step));
+  }
+  if (steps.size() < 3) return std::nan("");
+  const size_t k = (3 * steps.size()) / 4;
+  std::nth_element(steps.begin(), steps.begin() + k, steps.end());
+  return steps[k];
 }
 
 std::vector<Band> ModelBands(const LongSideDetection& detection,
@@ -1273,6 +1307,49 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
         VLOG(2) << "band " << i << " side " << side
                 << ": a transversal edge runs on beyond the band";
         break;
+      }
+      // A seen end is the paint ending against the road: its grey-level
+      // step is of the order of the long sides'. A weak Hough maximum in
+      // plain paint (the band running on out of view, under the vehicle)
+      // is not an end.
+      {
+        Eigen::Vector2d corner[4];
+        for (int v = 0; v < 4 && !failed; ++v) {
+          failed = !Intersect(long_lines[long_of[v]],
+                              transversal_lines[end_of[v]], &corner[v]);
+        }
+        for (int e = 0; e < 2 && !failed; ++e) {
+          if (known[e].line != nullptr) continue;
+          // The long sides' step near this end (a shadow across the band
+          // lowers both alike): over 8-32 % of the band from the end.
+          double long_step = 0.0;
+          int long_count = 0;
+          for (int k = 0; k < 2; ++k) {
+            if (pairs[i].inferred == k) continue;
+            const Eigen::Vector2d at_end = corner[e == 0 ? k : 3 - k];
+            const Eigen::Vector2d other_end = corner[e == 0 ? 3 - k : k];
+            const double step = EdgeStep(edges[side], long_lines[k], at_end,
+                                         at_end + 0.4 * (other_end - at_end),
+                                         options.end_step_profile_px);
+            if (std::isfinite(step)) {
+              long_step += step;
+              ++long_count;
+            }
+          }
+          if (long_count == 0) continue;
+          const double step = EdgeStep(
+              edges[side], transversal_lines[e], corner[e == 0 ? 0 : 3],
+              corner[e == 0 ? 1 : 2], options.end_step_profile_px);
+          const double ratio = step / (long_step / long_count);
+          VLOG(2) << "band " << i << " side " << side << " end " << e
+                  << ": step " << ratio << " of the long sides'";
+          failed = !(ratio >= options.min_end_step_fraction);
+        }
+        if (failed) {
+          VLOG(2) << "band " << i << " side " << side
+                  << ": a transversal side without the paint's step";
+          break;
+        }
       }
       for (int v = 0; v < 4; ++v) vertex_sum[v] += vertex_side[side][v];
       ++views;

@@ -160,6 +160,40 @@ TEST(HoughTransversal, PaintedEndStopsAtTheBandAShadowBoundaryRunsOn) {
   EXPECT_EQ(TransversalRunOn(road_edges, shadow[0], shadow_ends, neither), 0.0);
 }
 
+TEST(EdgeStep, APaintedEndStepsLikeTheLongSidesALineInPlainPaintDoesNot) {
+  const cv::Mat band = RenderBand(0.7);
+  const EdgeMap edges = DetectSubpixelEdges(band, cv::Mat(), EdgeOptions());
+  const BandOptions options;
+  auto horizontal = [](double y) {
+    ImageLine line;
+    line.normal = Eigen::Vector2d(0, 1);
+    line.rho = y;
+    return line;
+  };
+  ImageLine long_side;
+  long_side.normal = Eigen::Vector2d(1, 0);
+  long_side.rho = 70.0;
+  const double long_step =
+      EdgeStep(edges, long_side, Eigen::Vector2d(70, 80),
+               Eigen::Vector2d(70, 220), options.end_step_profile_px);
+  // Paint 120 grey levels over the asphalt.
+  EXPECT_NEAR(long_step, 120.0, 12.0);
+  // The begin side, skewed: a line along it between the long sides.
+  const double t = std::tan(kSkew);
+  ImageLine end;
+  end.normal = Eigen::Vector2d(-std::sin(kSkew), std::cos(kSkew));
+  end.rho = end.normal.dot(Eigen::Vector2d(86.5, 60.0));
+  const double end_step = EdgeStep(
+      edges, end, Eigen::Vector2d(70, 60 + t * (70 - 86.5)),
+      Eigen::Vector2d(103, 60 + t * (103 - 86.5)), options.end_step_profile_px);
+  EXPECT_GT(end_step, 0.8 * long_step);
+  // Across the middle of the band: paint on both sides, only noise.
+  const double paint_step =
+      EdgeStep(edges, horizontal(150.0), Eigen::Vector2d(70, 150),
+               Eigen::Vector2d(103, 150), options.end_step_profile_px);
+  EXPECT_LT(paint_step, options.min_end_step_fraction * long_step);
+}
+
 TEST(BandOptions, CheckNamesTheBadField) {
   BandOptions options;
   options.hough_score_fraction = 1.5;
