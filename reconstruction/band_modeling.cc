@@ -1273,11 +1273,11 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       const Eigen::Vector3d centre = side == 0
                                          ? rectification.left_centre_body()
                                          : rectification.right_centre_body();
+      Eigen::Vector2d corner[4];  // the vertices in this rectified image
       for (int v = 0; v < 4 && !failed; ++v) {
-        Eigen::Vector2d xy;
         if (!Intersect(long_lines[long_of[v]], transversal_lines[end_of[v]],
-                       &xy) ||
-            !plane.IntersectRay(centre, rectification.RayBody(side, xy),
+                       &corner[v]) ||
+            !plane.IntersectRay(centre, rectification.RayBody(side, corner[v]),
                                 &vertex_side[side][v])) {
           failed = true;
           VLOG(2) << "band " << i << " side " << side
@@ -1313,11 +1313,6 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       // plain paint (the band running on out of view, under the vehicle)
       // is not an end.
       {
-        Eigen::Vector2d corner[4];
-        for (int v = 0; v < 4 && !failed; ++v) {
-          failed = !Intersect(long_lines[long_of[v]],
-                              transversal_lines[end_of[v]], &corner[v]);
-        }
         for (int e = 0; e < 2 && !failed; ++e) {
           if (known[e].line != nullptr) continue;
           // The long sides' step near this end (a shadow across the band
