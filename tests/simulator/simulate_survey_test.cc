@@ -68,8 +68,12 @@ double Sample(const cv::Mat& image, double u, double v) {
 }
 
 // Offsets (px) of the painted edge from the projected long sides of the
-// true bands, measured across each side (the method of check_survey.py).
-std::vector<double> EdgeOffsets(const std::string& folder) {
+// true bands, measured across each side (the method of check_survey.py), in
+// the images of the cameras whose name starts with `camera_prefix`, for
+// the bands whose centre is min_range_m to 15 m from the camera.
+std::vector<double> EdgeOffsets(const std::string& folder,
+                                const std::string& camera_prefix = "",
+                                double min_range_m = 0.0) {
   const Rig rig = ReadRig(folder + "/rig.yaml", "rig.yaml");
   const SurveyManifest manifest = ReadManifest(folder);
   const LocalFrame frame(*manifest.origin);
@@ -84,6 +88,7 @@ std::vector<double> EdgeOffsets(const std::string& folder) {
     Pose pose;
     if (!truth.InterpolatePose(item.time, &pose)) continue;
     const RigCamera& rc = rig.cameras[item.camera];
+    if (rc.camera.name().rfind(camera_prefix, 0) != 0) continue;
     const Eigen::Isometry3d T_cam_enu =
         (pose.T_enu_body() * rc.T_body_cam).inverse();
     const cv::Mat image =
@@ -93,7 +98,8 @@ std::vector<double> EdgeOffsets(const std::string& folder) {
       std::array<Eigen::Vector3d, 4> c;
       for (int k = 0; k < 4; ++k) c[k] = frame.EnuFromGeodetic(band.corners[k]);
       const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
-      if ((T_cam_enu * centre).norm() > 15.0) continue;
+      const double range = (T_cam_enu * centre).norm();
+      if (range > 15.0 || range < min_range_m) continue;
       for (int side = 0; side < 4; ++side) {
         const Eigen::Vector3d& a = c[side];
         const Eigen::Vector3d& b = c[(side + 1) % 4];
@@ -211,6 +217,43 @@ TEST(SimulateSurvey, SmallSurveyMatchesItsTruthAndTheContract) {
         python + " " + checker + " " + folder + " > " + log + " 2>&1";
     EXPECT_EQ(std::system(command.c_str()), 0) << ReadFile(log);
   }
+}
+
+// A second stereo pair looking backwards: four cameras, two pairs in
+// rig.yaml, and the rear images show the road already driven with its
+// bands where the true corners project (the renderer draws the road in the
+// direction each camera looks).
+TEST(SimulateSurvey, RearPairSeesTheBandsBehindTheVehicle) {
+  TemporaryFolder temporary;
+  const std::string folder = temporary.Path("survey");
+  SimulationOptions options = SmallSurvey(3);
+  options.rear_pair = true;
+  const SimulationSummary summary = SimulateSurvey(options, folder, nullptr);
+  EXPECT_EQ(summary.num_images, 4 * summary.num_exposures);
+
+  const Rig rig = ReadRig(folder + "/rig.yaml", "rig.yaml");
+  ASSERT_EQ(rig.cameras.size(), 4u);
+  ASSERT_EQ(rig.stereo_pairs.size(), 2u);
+  EXPECT_EQ(rig.cameras[rig.stereo_pairs[1][0]].camera.name(), "rear_left");
+  EXPECT_EQ(rig.cameras[rig.stereo_pairs[1][1]].camera.name(), "rear_right");
+  for (int c : rig.stereo_pairs[1]) {
+    const Eigen::Isometry3d& T = rig.cameras[c].T_body_cam;
+    EXPECT_LT(T.linear().col(2).x(), -0.9);  // looks backwards
+    EXPECT_NEAR(T.translation().x(), -options.rear_camera_back_m, 0.02);
+  }
+  // Seen from behind, the pair's left camera is on the body's right (+y).
+  EXPECT_NEAR(
+      rig.cameras[rig.stereo_pairs[1][0]].T_body_cam.translation().y() -
+          rig.cameras[rig.stereo_pairs[1][1]].T_body_cam.translation().y(),
+      options.stereo_baseline_m, 0.02);
+
+  // Bands 12 m behind the camera and farther: beyond the stretch behind the
+  // vehicle that a forward-looking camera's road covers.
+  const std::vector<double> offsets = EdgeOffsets(folder, "rear_", 12.0);
+  ASSERT_GT(offsets.size(), 20u) << "bands behind the vehicle not drawn";
+  std::vector<double> sorted = offsets;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_LT(std::abs(sorted[sorted.size() / 2]), 0.15);
 }
 
 TEST(SimulateSurvey, SameSeedGivesIdenticalFilesAndAnotherSeedDiffers) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "tools/simulator/noise.h"
 
@@ -274,16 +275,29 @@ Rig MakeRig(const SimulationOptions& options) {
   Rig rig;
   const double alpha = options.camera_pitch_down_deg * kDegToRad;
   // Camera axes in the body (FRD): x_cam = right, z_cam = forward pitched
-  // down by alpha, y_cam = z_cam x x_cam (down-ish).
-  Eigen::Matrix3d R_body_cam_nominal;
-  R_body_cam_nominal.col(0) = Eigen::Vector3d(0.0, 1.0, 0.0);
-  R_body_cam_nominal.col(1) =
-      Eigen::Vector3d(-std::sin(alpha), 0.0, std::cos(alpha));
-  R_body_cam_nominal.col(2) =
-      Eigen::Vector3d(std::cos(alpha), 0.0, std::sin(alpha));
-  const char* names[2] = {"left", "right"};
-  for (int c = 0; c < 2; ++c) {
-    const double side = c == 0 ? -0.5 : 0.5;
+  // down by alpha, y_cam = z_cam x x_cam (down-ish). Looking backwards, the
+  // image's right is the body's left.
+  auto nominal_rotation = [alpha](bool backwards) {
+    const double f = backwards ? -1.0 : 1.0;
+    Eigen::Matrix3d R;
+    R.col(0) = Eigen::Vector3d(0.0, f, 0.0);
+    R.col(1) = Eigen::Vector3d(-f * std::sin(alpha), 0.0, std::cos(alpha));
+    R.col(2) = Eigen::Vector3d(f * std::cos(alpha), 0.0, std::sin(alpha));
+    return R;
+  };
+  struct Mount {
+    const char* name;
+    bool backwards;
+    double side;  // across the pair's own view: -0.5 left, +0.5 right
+  };
+  std::vector<Mount> mounts = {{"left", false, -0.5}, {"right", false, 0.5}};
+  if (options.rear_pair) {
+    mounts.push_back({"rear_left", true, -0.5});
+    mounts.push_back({"rear_right", true, 0.5});
+  }
+  for (size_t c = 0; c < mounts.size(); ++c) {
+    const Mount& mount = mounts[c];
+    const double f = mount.backwards ? -1.0 : 1.0;
     const double m = options.camera_misalignment_deg * kDegToRad;
     const Eigen::Matrix3d misalignment =
         (Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitX()) *
@@ -291,26 +305,32 @@ Rig MakeRig(const SimulationOptions& options) {
          Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitZ()))
             .toRotationMatrix();
     RigCamera camera;
-    camera.T_body_cam.linear() = R_body_cam_nominal * misalignment;
-    camera.T_body_cam.translation() = Eigen::Vector3d(
-        options.camera_forward_m + Uniform(&rng, -0.01, 0.01),
-        side * options.stereo_baseline_m + Uniform(&rng, -0.005, 0.005),
-        -(options.camera_height_m - options.imu_height_m));
-    const double scale = c == 0 ? 1.0 : Uniform(&rng, 0.995, 1.005);
+    camera.T_body_cam.linear() =
+        nominal_rotation(mount.backwards) * misalignment;
+    camera.T_body_cam.translation() =
+        Eigen::Vector3d((mount.backwards ? -options.rear_camera_back_m
+                                         : options.camera_forward_m) +
+                            Uniform(&rng, -0.01, 0.01),
+                        f * mount.side * options.stereo_baseline_m +
+                            Uniform(&rng, -0.005, 0.005),
+                        -(options.camera_height_m - options.imu_height_m));
+    const bool first = c % 2 == 0;
+    const double scale = first ? 1.0 : Uniform(&rng, 0.995, 1.005);
     const double fx = options.focal_px * scale;
     const double fy = fx * Uniform(&rng, 0.999, 1.001);
     const double cx =
         0.5 * (options.image_width - 1) + Uniform(&rng, -8.0, 8.0);
     const double cy =
         0.5 * (options.image_height - 1) + Uniform(&rng, -8.0, 8.0);
-    const double d = c == 0 ? 1.0 : Uniform(&rng, 0.97, 1.03);
-    camera.camera = Camera(names[c], options.image_width, options.image_height,
-                           fx, fy, cx, cy,
+    const double d = first ? 1.0 : Uniform(&rng, 0.97, 1.03);
+    camera.camera = Camera(mount.name, options.image_width,
+                           options.image_height, fx, fy, cx, cy,
                            {options.k1 * d, options.k2 * d, options.p1 * d,
                             options.p2 * d, options.k3 * d});
     rig.cameras.push_back(camera);
   }
   rig.stereo_pairs.push_back({0, 1});
+  if (options.rear_pair) rig.stereo_pairs.push_back({2, 3});
   return rig;
 }
 

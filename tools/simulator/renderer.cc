@@ -202,8 +202,13 @@ ImageScene::ImageScene(const World& world, const RenderSettings& settings,
   double l = 0.0;
   road_.ToRoadCoordinates(C_.head<2>(), s_hint, &s_cam_, &l);
   z_below_cam_ = road_.Height(s_cam_, l);
-  s_lo_ = s_cam_ - 8.0;
-  s_hi_ = s_cam_ + settings.max_ground_range_m;
+  // The road is drawn from 8 m behind the camera to max_ground_range_m in
+  // front of it, along the road in the direction it looks (a rear camera
+  // sees the road it has driven).
+  const bool looks_back =
+      R_enu_cam_.col(2).head<2>().dot(road_.Tangent(s_cam_)) < 0.0;
+  s_lo_ = looks_back ? s_cam_ - settings.max_ground_range_m : s_cam_ - 8.0;
+  s_hi_ = looks_back ? s_cam_ + 8.0 : s_cam_ + settings.max_ground_range_m;
   crown_s0_ = s_lo_ - 5.0;
   const int n = static_cast<int>((s_hi_ + 5.0 - crown_s0_) / kCrownStep) + 2;
   crown_z_.resize(n);

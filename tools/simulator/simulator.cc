@@ -113,6 +113,8 @@ const std::vector<Field>& Fields() {
       ZEBRAGEO_SIM_FIELD(camera_height_m),
       ZEBRAGEO_SIM_FIELD(camera_forward_m),
       ZEBRAGEO_SIM_FIELD(camera_pitch_down_deg),
+      ZEBRAGEO_SIM_FIELD(rear_pair),
+      ZEBRAGEO_SIM_FIELD(rear_camera_back_m),
       ZEBRAGEO_SIM_FIELD(camera_misalignment_deg),
       ZEBRAGEO_SIM_FIELD(image_width),
       ZEBRAGEO_SIM_FIELD(image_height),
@@ -363,6 +365,7 @@ std::string SimulationOptions::Check() const {
   c.Range("camera_height_m", camera_height_m, imu_height_m + 0.2, 5.0);
   c.Range("camera_forward_m", camera_forward_m, -3.0, 3.0);
   c.Range("camera_pitch_down_deg", camera_pitch_down_deg, 0.0, 60.0);
+  c.Range("rear_camera_back_m", rear_camera_back_m, 0.0, 5.0);
   c.Range("camera_misalignment_deg", camera_misalignment_deg, 0.0, 3.0);
   c.Range("image_width", image_width, 64, 8192);
   c.Range("image_height", image_height, 64, 8192);

@@ -159,6 +159,11 @@ struct SimulationOptions {
   double camera_forward_m = 0.8;
   // Downward pitch of the optical axes from the vehicle's forward axis.
   double camera_pitch_down_deg = 20.0;
+  // A second stereo pair looking backwards (cameras rear_left, rear_right),
+  // rear_camera_back_m behind the IMU, same height, baseline and pitch: a
+  // rig of two stereo pairs, as rig.yaml's stereo_pairs allows.
+  bool rear_pair = false;
+  double rear_camera_back_m = 1.5;
   // Small rotations of each camera off the nominal mounting (realism).
   double camera_misalignment_deg = 0.3;
   int image_width = 1280;
