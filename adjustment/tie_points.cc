@@ -235,14 +235,28 @@ std::vector<TieTrack> BuildTieTracks(
     exposure_index[exposures.exposures[e].exposure_id] = e;
   }
   const double min_angle = options.min_triangulation_angle_deg * kPi / 180.0;
+  // Why matched components did not become tracks (VLOG(1)): a diagnosis of
+  // a scene whose ties are few.
+  struct Rejections {
+    int components = 0, short_track = 0, same_image = 0, narrow_angle = 0,
+        reprojection = 0, one_exposure = 0, no_stereo = 0;
+  } rejected;
   for (const auto& [root, nodes] : components) {
-    if (static_cast<int>(nodes.size()) < options.min_track_length) continue;
+    if (nodes.size() < 2) continue;
+    ++rejected.components;
+    if (static_cast<int>(nodes.size()) < options.min_track_length) {
+      ++rejected.short_track;
+      continue;
+    }
     std::vector<int> images;
     bool conflict = false;
     for (int node : nodes) images.push_back(node_key[node].first);
     std::sort(images.begin(), images.end());
     conflict = std::adjacent_find(images.begin(), images.end()) != images.end();
-    if (conflict) continue;
+    if (conflict) {
+      ++rejected.same_image;
+      continue;
+    }
     // Midpoint triangulation of the rays.
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
@@ -267,7 +281,10 @@ std::vector<TieTrack> BuildTieTracks(
             std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
       }
     }
-    if (max_angle < min_angle) continue;
+    if (max_angle < min_angle) {
+      ++rejected.narrow_angle;
+      continue;
+    }
     Candidate candidate;
     bool good = true;
     for (int node : nodes) {
@@ -288,13 +305,19 @@ std::vector<TieTrack> BuildTieTracks(
            std::pow(kOrbScaleFactor, f.keypoints[k].octave)});
       candidate.exposures.push_back(exposure_index[info.exposure_id]);
     }
-    if (!good) continue;
+    if (!good) {
+      ++rejected.reprojection;
+      continue;
+    }
     candidate.track.p_enu = X;
     std::sort(candidate.exposures.begin(), candidate.exposures.end());
     candidate.exposures.erase(
         std::unique(candidate.exposures.begin(), candidate.exposures.end()),
         candidate.exposures.end());
-    if (candidate.exposures.size() < 2) continue;  // ties exposures together
+    if (candidate.exposures.size() < 2) {  // ties exposures together
+      ++rejected.one_exposure;
+      continue;
+    }
     // A stereo observation fixes the depth: a temporal mismatch on a
     // repeated pattern (windows, bands) that slides along the epipolar line
     // cannot agree with it.
@@ -305,10 +328,20 @@ std::vector<TieTrack> BuildTieTracks(
         const int e = exposure_index[exposures.images[o.image].exposure_id];
         stereo |= ++cameras_in_exposure[e] >= 2;
       }
-      if (!stereo) continue;
+      if (!stereo) {
+        ++rejected.no_stereo;
+        continue;
+      }
     }
     candidates.push_back(std::move(candidate));
   }
+  VLOG(1) << "tie points: " << rejected.components
+          << " matched components; too short " << rejected.short_track
+          << ", two keypoints in one image " << rejected.same_image
+          << ", intersection angle " << rejected.narrow_angle
+          << ", reprojection or range " << rejected.reprojection
+          << ", one exposure " << rejected.one_exposure << ", no stereo "
+          << rejected.no_stereo << "; " << candidates.size() << " candidates";
   // The longest tracks first, until every exposure has enough.
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) {

@@ -439,9 +439,9 @@ class AdjustmentProblem {
     const double widen =
         std::sqrt(std::max(1.0, options_.prior_correlation_time_s / dt));
     Eigen::Matrix<double, 6, 6> S_att = Eigen::Matrix<double, 6, 6>::Zero();
-    S_att.diagonal().head<3>().setConstant(
-        1.0 / (options_.ins_attitude_sigma_deg * kDegToRad));
-    S_att(2, 2) /= widen;  // heading: see ins_attitude_sigma_deg
+    S_att.diagonal().head<2>().setConstant(
+        1.0 / (options_.ins_tilt_sigma_deg * kDegToRad));
+    S_att(2, 2) = 1.0 / (options_.ins_heading_sigma_deg * kDegToRad) / widen;
     Eigen::Matrix<double, 6, 6> S_pos = Eigen::Matrix<double, 6, 6>::Zero();
     S_pos.diagonal().tail<3>() =
         Eigen::Vector3d(1.0 / state_->gnss_sigma_m.x(),
@@ -775,7 +775,8 @@ std::string AdjustmentOptions::Check() const {
       {"gnss_sigma_horizontal_m", gnss_sigma_horizontal_m},
       {"gnss_sigma_vertical_m", gnss_sigma_vertical_m},
       {"gnss_loss_scale", gnss_loss_scale},
-      {"ins_attitude_sigma_deg", ins_attitude_sigma_deg},
+      {"ins_tilt_sigma_deg", ins_tilt_sigma_deg},
+      {"ins_heading_sigma_deg", ins_heading_sigma_deg},
       {"prior_correlation_time_s", prior_correlation_time_s},
       {"min_gnss_sigma_m", min_gnss_sigma_m},
       {"drift_rate_sigma_mps", drift_rate_sigma_mps},

@@ -78,13 +78,18 @@ struct AdjustmentOptions {
   // that error (an adjustment must not make the trajectory worse).
   bool estimate_gnss_sigma = true;
   double min_gnss_sigma_m = 0.03;
-  // The INS absolute attitude (heading and tilt drift of a tactical-grade
-  // INS: a few hundredths of a degree to a tenth). Tilt per knot (gravity
-  // holds it); heading, like the position, once per
-  // prior_correlation_time_s: its drift is slow, and counting it per knot
-  // would hold the heading to the INS's where only the vehicle's motion
-  // and road lines control it.
-  double ins_attitude_sigma_deg = 0.2;
+  // The INS absolute attitude, tilt and heading apart: they drift
+  // differently. Tilt (roll, pitch) is held by gravity; its prior holds per
+  // knot (0.2 deg per knot bounds the mean tilt correction over the
+  // correlation time to about 0.04 deg, a tactical-grade INS's tilt drift),
+  // and the data hold tilt only weakly (a crossing's database heights give
+  // its tilt to about 0.2 deg). Heading drifts like the position (a few
+  // hundredths of a degree to a tenth), once per prior_correlation_time_s:
+  // counting it per knot would hold the heading to the INS's where only
+  // the vehicle's motion and road lines control it. A better INS: lower
+  // ins_tilt_sigma_deg.
+  double ins_tilt_sigma_deg = 0.2;
+  double ins_heading_sigma_deg = 0.2;
   // Correlation time of the GNSS/INS error (its drift): the two priors
   // above hold once per this time, so each knot's prior is widened by
   // sqrt(prior_correlation_time_s / knot_spacing_s).
