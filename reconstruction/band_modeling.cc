@@ -544,6 +544,9 @@ std::string BandOptions::Check() const {
   } else if (!(inferred_score_factor > 0.0 && inferred_score_factor <= 1.0)) {
     error << "inferred_score_factor = " << inferred_score_factor
           << ": must be in (0, 1]";
+  } else if (!(max_end_angle_rad > 0.0 && max_end_angle_rad < 1.5)) {
+    error << "max_end_angle_rad = " << max_end_angle_rad
+          << ": must be in (0, 1.5)";
   } else if (!(max_transversal_run_on > 0.0)) {
     error << "max_transversal_run_on = " << max_transversal_run_on
           << ": must be > 0";
@@ -809,6 +812,12 @@ double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
     if (std::isfinite(outside)) run_on = std::max(run_on, outside / inside);
   }
   return run_on;
+}
+
+double EndAngleRad(const std::array<Eigen::Vector3d, 4>& vertices) {
+  const Eigen::Vector3d begin = vertices[1] - vertices[0];
+  const Eigen::Vector3d end = vertices[2] - vertices[3];
+  return std::atan2(begin.cross(end).norm(), std::abs(begin.dot(end)));
 }
 
 double EdgeStep(const EdgeMap& edges, const ImageLine& line,
@@ -1394,6 +1403,12 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     if (band.length_m < zebra.min_band_length_m - 0.5 ||
         band.length_m > zebra.max_band_length_m + 0.5) {
       VLOG(2) << "band " << i << ": length " << band.length_m;
+      return BandOutcome::kRejected;
+    }
+    // A painted band is a parallelogram: its ends are parallel.
+    const double end_angle = EndAngleRad(band.vertices_body);
+    if (!(end_angle <= options.max_end_angle_rad)) {
+      VLOG(2) << "band " << i << ": ends " << end_angle << " rad from parallel";
       return BandOutcome::kRejected;
     }
 

@@ -70,6 +70,14 @@ struct BandOptions {
   // end is above 0.62; the two below, 0.22 and 0.28, were in plain paint.
   double min_end_step_fraction = 0.35;
   double end_step_profile_px = 8.0;
+  // A band is painted as a parallelogram: its two ends (averaged over the
+  // two images) are parallel within this angle. A dark stain on the paint
+  // cuts a band with a slanted "end" (ambiguity seed 2: 0.50 rad). On 9
+  // surveys (demo, urban seeds 1-3, outage, ambiguity seed 2 and three
+  // contract variants) the good bands' ends are within 0.125 rad, the
+  // farthest (13-15 m) the least parallel; above 0.2 were that stain and
+  // two far bands with vertices 10 cm off.
+  double max_end_angle_rad = 0.2;
   // The left and right images give two estimates of each vertex; a band
   // whose estimates differ by more is dropped.
   double max_stereo_disagreement_m = 0.05;
@@ -179,6 +187,10 @@ double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
 double EdgeStep(const EdgeMap& edges, const ImageLine& line,
                 const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                 double half_width_px);
+
+// Angle (radians, 0..pi/2) between a band's two ends, v0-v1 and v3-v2
+// (vertices in order around the band): 0 for a parallelogram.
+double EndAngleRad(const std::array<Eigen::Vector3d, 4>& vertices);
 
 struct Band {
   std::array<Eigen::Vector3d, 4> vertices_body;
