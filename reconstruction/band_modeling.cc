@@ -697,6 +697,7 @@ bool RefineImageLine(const EdgeMap& edges, const Area& area,
   const int half = static_cast<int>(std::ceil(reach / step));
   ImageLine current = *line;
   std::vector<double> profile(2 * half + 1);
+  std::vector<char> seen(2 * half + 1);
   for (int round = 0; round < 3; ++round) {
     const Eigen::Vector2d direction(-current.normal.y(), current.normal.x());
     const Eigen::Vector2d origin = current.rho * current.normal;
@@ -710,23 +711,32 @@ bool RefineImageLine(const EdgeMap& edges, const Area& area,
     for (double t = std::ceil(t_min); t <= t_max; t += 1.0) {
       const Eigen::Vector2d base = origin + t * direction;
       if (!InsideConvex(area, base)) continue;
+      // The profile may run out of the image (an end a little inside the
+      // bottom edge): the edge position holds as long as the peak and its
+      // part above a third are seen, bounded by seen samples below it.
       int peak = -1;
-      bool usable = true;
-      for (int k = -half; k <= half && usable; ++k) {
+      for (int k = -half; k <= half; ++k) {
         const Eigen::Vector2d p = base + k * step * current.normal;
-        usable = edges.IsUsable(p.x(), p.y());
+        seen[k + half] = edges.IsUsable(p.x(), p.y());
+        profile[k + half] = 0.0;
+        if (!seen[k + half]) continue;
         const cv::Vec2f g = edges.GradientAt(p.x(), p.y());
         profile[k + half] =
             std::max(0.0, polarity.x() * g[0] + polarity.y() * g[1]);
         if (peak < 0 || profile[k + half] > profile[peak]) peak = k + half;
       }
-      if (!usable) continue;
+      if (peak < 0 || !seen[half]) continue;
       const double top = profile[peak];
       if (!(top >= options.hough_min_gradient)) continue;
       if (peak == 0 || peak == 2 * half) continue;  // edge outside the window
       int lo = peak, hi = peak;
-      while (lo > 0 && profile[lo - 1] > top / 3.0) --lo;
-      while (hi < 2 * half && profile[hi + 1] > top / 3.0) ++hi;
+      while (lo > 0 && seen[lo - 1] && profile[lo - 1] > top / 3.0) --lo;
+      while (hi < 2 * half && seen[hi + 1] && profile[hi + 1] > top / 3.0) {
+        ++hi;
+      }
+      if ((lo > 0 && !seen[lo - 1]) || (hi < 2 * half && !seen[hi + 1])) {
+        continue;  // the edge's profile is cut by the image's border
+      }
       double sum = 0.0, moment = 0.0;
       for (int k = lo; k <= hi; ++k) {
         const double w = profile[k] - top / 3.0;
@@ -832,15 +842,26 @@ double EdgeStep(const EdgeMap& edges, const ImageLine& line,
     // The point of the line nearest a + t * unit.
     const Eigen::Vector2d q = a + t * unit;
     const Eigen::Vector2d p = q - line.Distance(q) * line.normal;
+    // Over +-half_width_px, or as much of it as the image holds on both
+    // sides (an end near the image's border), at least +-3 px: a painted
+    // edge's step is within a few pixels of it.
     double step = 0.0;
-    bool usable = true;
-    for (double u = -half_width_px; u <= half_width_px && usable; u += 1.0) {
-      const Eigen::Vector2d x = p + u * line.normal;
-      usable = edges.IsUsable(x.x(), x.y());
-      const cv::Vec2f g = edges.GradientAt(x.x(), x.y());
-      step += line.normal.x() * g[0] + line.normal.y() * g[1];
+    int reach = 0;
+    for (int u = 0; u <= static_cast<int>(half_width_px); ++u) {
+      const Eigen::Vector2d x0 = p + u * line.normal;
+      const Eigen::Vector2d x1 = p - u * line.normal;
+      if (!edges.IsUsable(x0.x(), x0.y()) || !edges.IsUsable(x1.x(), x1.y())) {
+        break;
+      }
+      const cv::Vec2f g0 = edges.GradientAt(x0.x(), x0.y());
+      step += line.normal.x() * g0[0] + line.normal.y() * g0[1];
+      if (u > 0) {
+        const cv::Vec2f g1 = edges.GradientAt(x1.x(), x1.y());
+        step += line.normal.x() * g1[0] + line.normal.y() * g1[1];
+      }
+      reach = u;
     }
-    if (usable) steps.push_back(std::abs(step));
+    if (reach >= 3) steps.push_back(std::abs(step));
   }
   if (steps.size() < 3) return std::nan("");
   const size_t k = (3 * steps.size()) / 4;
@@ -1250,7 +1271,8 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
         if (!RefineImageLine(edges[side], areas[e], options,
                              &transversal_lines[e])) {
           failed = transversal_failed = true;
-          VLOG(2) << "band " << i << " side " << side << ": refinement failed";
+          VLOG(2) << "band " << i << " side " << side << " end " << e
+                  << ": refinement failed";
           break;
         }
         line_sigma_px[side][e] = std::max(
@@ -1380,13 +1402,17 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                 band.vertices_body[2] + band.vertices_body[3]);
     const double range =
         (band_middle - rectification.left_centre_body()).norm();
-    if (range > options.max_band_range_m) return BandOutcome::kRejected;
+    if (range > options.max_band_range_m) {
+      VLOG(2) << "band " << i << ": range " << range;
+      return BandOutcome::kRejected;
+    }
     // An inferred side or end is extrapolated: far away, its error grows
     // past what a control point may carry (a closer exposure sees it).
     const bool extrapolated = pairs[i].inferred >= 0 ||
                               known[0].line != nullptr ||
                               known[1].line != nullptr;
     if (extrapolated && range > options.max_inferred_range_m) {
+      VLOG(2) << "band " << i << ": extrapolated at range " << range;
       return BandOutcome::kRejected;
     }
     if (disagreement > options.max_stereo_disagreement_m) {

@@ -194,6 +194,30 @@ TEST(EdgeStep, APaintedEndStepsLikeTheLongSidesALineInPlainPaintDoesNot) {
   EXPECT_LT(paint_step, options.min_end_step_fraction * long_step);
 }
 
+// A near end a few pixels inside the border of what the images see (a
+// band's end just above the bottom of the image): the refinement and the
+// end's step use what the image holds on both sides of the edge.
+TEST(HoughTransversal, AnEndNearTheImageBorderIsRefinedAndStepsLikeThePaint) {
+  const cv::Mat image = RenderBand(0.7);
+  // Nothing is seen above y = 50: the end (y = 56 to 64 across the band)
+  // is 6-14 px inside, less than the profiles' reach.
+  cv::Mat valid(image.size(), CV_8U, cv::Scalar(255));
+  valid.rowRange(0, 50).setTo(0);
+  const EdgeMap edges = DetectSubpixelEdges(image, valid, EdgeOptions());
+  const BandOptions options;
+  const std::vector<ImageLine> begin = HoughTransversalCandidates(
+      edges, Area(60.0), Eigen::Vector2d(0.0, 1.0), options);
+  ASSERT_FALSE(begin.empty());
+  ImageLine top = begin[0];
+  ASSERT_TRUE(RefineImageLine(edges, Area(60.0), options, &top));
+  ExpectSkewedSide(top, 60.0, 0.7);
+  const double t = std::tan(kSkew);
+  const double end_step = EdgeStep(
+      edges, top, Eigen::Vector2d(70, 60 + t * (70 - 86.5)),
+      Eigen::Vector2d(103, 60 + t * (103 - 86.5)), options.end_step_profile_px);
+  EXPECT_NEAR(end_step, 120.0, 15.0);  // the paint's 120 grey levels
+}
+
 TEST(EndAngle, ZeroForASkewedBandLargeForAStainCutEnd) {
   // A band 0.5 m wide, 3 m long, skewed 30 degrees (x along the band).
   const double skew = 30.0 * M_PI / 180.0;
