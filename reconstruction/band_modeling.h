@@ -180,7 +180,8 @@ double TransversalRunOn(const EdgeMap& edges, const ImageLine& line,
 
 // Grey-level step across `line` between the points a and b (inset by a
 // fifth of their distance at each end): at each pixel along the line the
-// gradient along its normal summed over +-half_width_px, of which the
+// gradient along its normal summed over +-half_width_px (or the largest
+// symmetric part of it the image holds, at least +-3 px), of which the
 // upper quartile is returned. The step, not the sharpness: a far side
 // blurred by the resampling keeps its value, and an end worn or stained
 // over part of its length keeps it. NaN when too little is usable.
