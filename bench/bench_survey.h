@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "reconstruction/road_rectification.h"
+#include "simulator/simulator.h"
 #include "survey/survey.h"
-#include "tools/simulator/simulator.h"
 
 namespace zebrageo {
 

@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "simulator/bad_survey.h"
+#include "simulator/simulator.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
-#include "tools/simulator/bad_survey.h"
-#include "tools/simulator/simulator.h"
 
 namespace zebrageo {
 namespace {

@@ -14,9 +14,9 @@
 #include <random>
 #include <set>
 
+#include "simulator/simulator.h"
 #include "survey/roadmarks.h"
 #include "survey/trajectory.h"
-#include "tools/simulator/simulator.h"
 
 namespace zebrageo {
 namespace {

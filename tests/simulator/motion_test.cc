@@ -1,12 +1,12 @@
 // The vehicle motion, GNSS/INS error model, rig and exposure times.
-#include "tools/simulator/motion.h"
+#include "simulator/motion.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "tools/simulator/world.h"
+#include "simulator/world.h"
 
 namespace zebrageo::sim {
 namespace {

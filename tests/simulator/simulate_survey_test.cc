@@ -15,13 +15,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "simulator/simulator.h"
 #include "survey/exposures.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
 #include "survey/survey.h"
 #include "survey/trajectory.h"
 #include "tests/survey/test_util.h"
-#include "tools/simulator/simulator.h"
 
 namespace zebrageo {
 namespace {

@@ -2,7 +2,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "tools/simulator/simulator.h"
+#include "simulator/simulator.h"
 
 namespace zebrageo {
 namespace {

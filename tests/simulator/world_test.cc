@@ -1,6 +1,6 @@
 // The simulated world against the spec: road cross-section, band sizes,
 // planarity and ring order, database faults and offsets.
-#include "tools/simulator/world.h"
+#include "simulator/world.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <map>
 #include <set>
 
-#include "tools/simulator/road.h"
-#include "tools/simulator/simulator.h"
+#include "simulator/road.h"
+#include "simulator/simulator.h"
 
 namespace zebrageo::sim {
 namespace {

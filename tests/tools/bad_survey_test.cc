@@ -6,7 +6,7 @@
 // leaves no output; a usable one exits 0 with every output and a warning).
 // Then ../shared/tools/score_results.py badinput, the independent checker,
 // judges the same folder when it is present.
-#include "tools/simulator/bad_survey.h"
+#include "simulator/bad_survey.h"
 
 #include <gtest/gtest.h>
 

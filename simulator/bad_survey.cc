@@ -1,4 +1,4 @@
-#include "tools/simulator/bad_survey.h"
+#include "simulator/bad_survey.h"
 
 #include <algorithm>
 #include <filesystem>

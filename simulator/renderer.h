@@ -18,8 +18,8 @@
 // positions are sub-pixel exact.
 // Then Gaussian blur, vignetting, exposure gain, Gaussian + shot noise and
 // quantisation. Pixel (0, 0) is the centre of the top-left pixel.
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_RENDERER_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_RENDERER_H_
+#ifndef ZEBRAGEO_SIMULATOR_RENDERER_H_
+#define ZEBRAGEO_SIMULATOR_RENDERER_H_
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -27,9 +27,9 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "simulator/simulator.h"
+#include "simulator/world.h"
 #include "survey/camera.h"
-#include "tools/simulator/simulator.h"
-#include "tools/simulator/world.h"
 
 namespace zebrageo::sim {
 
@@ -101,4 +101,4 @@ class Renderer {
 
 }  // namespace zebrageo::sim
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_RENDERER_H_
+#endif  // ZEBRAGEO_SIMULATOR_RENDERER_H_

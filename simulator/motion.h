@@ -7,18 +7,18 @@
 // plus suspension oscillations) and converted to the INS attitude relative
 // to NED AT THE VEHICLE (LocalFrame::AttitudeFromRotationEnuBody).
 // Camera frame OpenCV; T_body_cam maps camera into body coordinates.
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_MOTION_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_MOTION_H_
+#ifndef ZEBRAGEO_SIMULATOR_MOTION_H_
+#define ZEBRAGEO_SIMULATOR_MOTION_H_
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
+#include "simulator/simulator.h"
+#include "simulator/world.h"
 #include "survey/geodesy.h"
 #include "survey/rig.h"
 #include "survey/trajectory.h"
-#include "tools/simulator/simulator.h"
-#include "tools/simulator/world.h"
 
 namespace zebrageo::sim {
 
@@ -50,4 +50,4 @@ Rig MakeRig(const SimulationOptions& options);
 
 }  // namespace zebrageo::sim
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_MOTION_H_
+#endif  // ZEBRAGEO_SIMULATOR_MOTION_H_

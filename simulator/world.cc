@@ -1,4 +1,4 @@
-#include "tools/simulator/world.h"
+#include "simulator/world.h"
 
 #include <glog/logging.h>
 
@@ -9,7 +9,7 @@
 #include <numeric>
 #include <random>
 
-#include "tools/simulator/noise.h"
+#include "simulator/noise.h"
 
 namespace zebrageo::sim {
 namespace {

@@ -22,8 +22,8 @@
 //
 // Everything is deterministic for a given `seed`: world, errors and each
 // image's noise come from generators seeded by (seed, purpose, image index).
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_SIMULATOR_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_SIMULATOR_H_
+#ifndef ZEBRAGEO_SIMULATOR_SIMULATOR_H_
+#define ZEBRAGEO_SIMULATOR_SIMULATOR_H_
 
 #include <cstdint>
 #include <functional>
@@ -326,4 +326,4 @@ SimulationSummary SimulateSurvey(
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_SIMULATOR_H_
+#endif  // ZEBRAGEO_SIMULATOR_SIMULATOR_H_

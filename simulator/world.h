@@ -12,8 +12,8 @@
 // Long sides are along t (the road), short sides along n + tan_skew t.
 // Corners lie on the road surface; the band is the planar quad through them
 // (they are coplanar to < 0.1 mm), which is what the renderer paints.
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_WORLD_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_WORLD_H_
+#ifndef ZEBRAGEO_SIMULATOR_WORLD_H_
+#define ZEBRAGEO_SIMULATOR_WORLD_H_
 
 #include <Eigen/Core>
 #include <array>
@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
+#include "simulator/road.h"
+#include "simulator/simulator.h"
 #include "survey/geodesy.h"
 #include "survey/roadmarks.h"
-#include "tools/simulator/road.h"
-#include "tools/simulator/simulator.h"
 
 namespace zebrageo::sim {
 
@@ -213,4 +213,4 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
 
 }  // namespace zebrageo::sim
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_WORLD_H_
+#endif  // ZEBRAGEO_SIMULATOR_WORLD_H_

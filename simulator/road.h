@@ -12,8 +12,8 @@
 // s) and circular arcs, stored as nodes every kNodeSpacing metres; between
 // nodes the curvature is linear, so positions are exact integrals of the
 // heading (3-point Gauss-Legendre, exact to ~1e-13 m over a node).
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_ROAD_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_ROAD_H_
+#ifndef ZEBRAGEO_SIMULATOR_ROAD_H_
+#define ZEBRAGEO_SIMULATOR_ROAD_H_
 
 #include <Eigen/Core>
 #include <array>
@@ -104,4 +104,4 @@ class Road {
 
 }  // namespace zebrageo::sim
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_ROAD_H_
+#endif  // ZEBRAGEO_SIMULATOR_ROAD_H_

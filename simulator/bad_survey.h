@@ -8,13 +8,13 @@
 // `zebrageo run` must exit non-zero with a message and leave no output; on
 // "warning" it must exit 0, write every output and list a warning in
 // report.json.
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_BAD_SURVEY_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_BAD_SURVEY_H_
+#ifndef ZEBRAGEO_SIMULATOR_BAD_SURVEY_H_
+#define ZEBRAGEO_SIMULATOR_BAD_SURVEY_H_
 
 #include <string>
 #include <vector>
 
-#include "tools/simulator/simulator.h"
+#include "simulator/simulator.h"
 
 namespace zebrageo {
 
@@ -44,4 +44,4 @@ void BreakSurvey(const std::string& kind, const std::string& folder);
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_BAD_SURVEY_H_
+#endif  // ZEBRAGEO_SIMULATOR_BAD_SURVEY_H_

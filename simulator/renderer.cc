@@ -1,4 +1,4 @@
-#include "tools/simulator/renderer.h"
+#include "simulator/renderer.h"
 
 #include <glog/logging.h>
 #include <time.h>
@@ -7,8 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "simulator/noise.h"
 #include "survey/threads.h"
-#include "tools/simulator/noise.h"
 
 namespace zebrageo::sim {
 namespace {

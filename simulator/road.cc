@@ -1,11 +1,11 @@
-#include "tools/simulator/road.h"
+#include "simulator/road.h"
 
 #include <glog/logging.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "tools/simulator/noise.h"
+#include "simulator/noise.h"
 
 namespace zebrageo::sim {
 namespace {

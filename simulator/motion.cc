@@ -1,4 +1,4 @@
-#include "tools/simulator/motion.h"
+#include "simulator/motion.h"
 
 #include <glog/logging.h>
 
@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "tools/simulator/noise.h"
+#include "simulator/noise.h"
 
 namespace zebrageo::sim {
 namespace {

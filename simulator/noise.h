@@ -6,8 +6,8 @@
 // SubSeed(seed, purpose, index), and textures are pure functions of world
 // coordinates (value noise on an integer lattice hashed with a salt), so the
 // same ground looks the same from every exposure and every thread.
-#ifndef ZEBRAGEO_TOOLS_SIMULATOR_NOISE_H_
-#define ZEBRAGEO_TOOLS_SIMULATOR_NOISE_H_
+#ifndef ZEBRAGEO_SIMULATOR_NOISE_H_
+#define ZEBRAGEO_SIMULATOR_NOISE_H_
 
 #include <algorithm>
 #include <cmath>
@@ -133,4 +133,4 @@ inline int PoissonCount(std::mt19937_64* rng, double mean) {
 
 }  // namespace zebrageo::sim
 
-#endif  // ZEBRAGEO_TOOLS_SIMULATOR_NOISE_H_
+#endif  // ZEBRAGEO_SIMULATOR_NOISE_H_

@@ -1,4 +1,4 @@
-#include "tools/simulator/simulator.h"
+#include "simulator/simulator.h"
 
 #include <glog/logging.h>
 
@@ -18,6 +18,10 @@
 #include <thread>
 #include <variant>
 
+#include "simulator/motion.h"
+#include "simulator/noise.h"
+#include "simulator/renderer.h"
+#include "simulator/world.h"
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/exposures.h"
@@ -25,10 +29,6 @@
 #include "survey/roadmarks.h"
 #include "survey/survey.h"
 #include "survey/trajectory.h"
-#include "tools/simulator/motion.h"
-#include "tools/simulator/noise.h"
-#include "tools/simulator/renderer.h"
-#include "tools/simulator/world.h"
 
 namespace zebrageo {
 namespace {
