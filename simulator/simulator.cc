@@ -21,6 +21,7 @@
 #include "simulator/motion.h"
 #include "simulator/noise.h"
 #include "simulator/renderer.h"
+#include "simulator/simulated_survey.h"
 #include "simulator/world.h"
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
@@ -56,6 +57,7 @@ struct Field {
 const std::vector<Field>& Fields() {
   static const std::vector<Field> fields = {
       ZEBRAGEO_SIM_FIELD(preset),
+      ZEBRAGEO_SIM_FIELD(scenario),
       ZEBRAGEO_SIM_FIELD(seed),
       ZEBRAGEO_SIM_FIELD(origin_lat_deg),
       ZEBRAGEO_SIM_FIELD(origin_lon_deg),
@@ -474,11 +476,14 @@ std::string SimulationOptions::Check() const {
 }
 
 std::vector<std::string> PresetNames() {
-  return {"demo", "urban", "outage", "sparse", "ambiguity", "large"};
+  return {"demo", "urban", "outage", "sparse", "ambiguity", "large", "random"};
 }
 
 std::string ApplyPreset(const std::string& name, SimulationOptions* options) {
   const uint64_t seed = options->seed;
+  if (name == "random") {
+    return DrawRandomOptions(seed, RandomPresetLimits(), options);
+  }
   SimulationOptions o;
   o.seed = seed;
   o.preset = name;
@@ -766,13 +771,6 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
   return meta;
 }
 
-std::string ImageName(int64_t exposure_id, const std::string& camera) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "images/%06lld_%s.png",
-                static_cast<long long>(exposure_id), camera.c_str());
-  return text;
-}
-
 }  // namespace
 
 SimulationSummary SimulateSurvey(
@@ -785,21 +783,16 @@ SimulationSummary SimulateSurvey(
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t)
         .count();
   };
-  const Geodetic origin{options.origin_lat_deg, options.origin_lon_deg,
-                        options.origin_h_m};
-  const LocalFrame frame(origin);
   LOG(INFO) << "simulate: preset " << options.preset << ", seed "
             << options.seed << ", " << options.road_length_m << " m";
-  const World world = sim::BuildWorld(options);
-  sim::VehicleMotion motion = sim::SimulateMotion(options, world, frame);
-  // Times on a clean decimal grid (1 us), so the files read naturally.
-  for (auto* samples : {&motion.truth, &motion.measured}) {
-    for (TrajectorySample& s : *samples) s.time = RoundTo(s.time, 1e-6);
-  }
-  for (sim::ExposureEvent& e : motion.exposures) {
-    e.time = RoundTo(e.time, 1e-4);
-  }
-  const Rig rig = sim::MakeRig(options);
+  const sim::SimulatedSurvey simulated = sim::MakeSimulatedSurvey(options);
+  const World& world = simulated.world;
+  const sim::VehicleMotion& motion = simulated.motion;
+  const Rig& rig = simulated.rig;
+  const ExposureTable& table = simulated.exposures;
+  const RoadmarkDatabase& database = simulated.database;
+  const RoadmarkDatabase& truth = simulated.truth;
+  const LocalFrame& frame = simulated.frame;
 
   SimulationSummary summary;
   summary.num_trajectory_samples = static_cast<int>(motion.truth.size());
@@ -825,24 +818,6 @@ SimulationSummary SimulateSurvey(
     throw std::runtime_error("cannot create " + output_folder + ": " +
                              ec.message());
   }
-
-  // Exposures: one image per camera, both with the exposure's id and time.
-  ExposureTable table;
-  for (const sim::ExposureEvent& e : motion.exposures) {
-    Exposure exposure;
-    exposure.exposure_id = e.exposure_id;
-    exposure.time = e.time;
-    for (int c = 0; c < static_cast<int>(rig.cameras.size()); ++c) {
-      ExposureImage image;
-      image.exposure_id = e.exposure_id;
-      image.time = e.time;
-      image.camera = c;
-      image.image = ImageName(e.exposure_id, rig.cameras[c].camera.name());
-      exposure.image_of_camera.push_back(static_cast<int>(table.images.size()));
-      table.images.push_back(image);
-    }
-    table.exposures.push_back(exposure);
-  }
   summary.num_exposures = static_cast<int>(table.exposures.size());
   summary.num_images = static_cast<int>(table.images.size());
 
@@ -851,9 +826,6 @@ SimulationSummary SimulateSurvey(
   WriteTrajectorySamples(motion.truth,
                          (folder / "truth" / "trajectory.csv").string());
   WriteExposures(table, rig, (folder / "exposures.csv").string());
-  const RoadmarkDatabase database =
-      sim::MakeDatabaseRoadmarks(world, options, frame);
-  const RoadmarkDatabase truth = sim::MakeTruthRoadmarks(world, frame);
   WriteRoadmarks(database, (folder / "roadmarks.geojson").string());
   WriteRoadmarks(truth, (folder / "truth" / "roadmarks.geojson").string());
   summary.num_bands_in_street = static_cast<int>(truth.bands.size());
@@ -938,7 +910,7 @@ SimulationSummary SimulateSurvey(
   SurveyManifest manifest;
   manifest.name =
       "zebrageo-sim-" + options.preset + "-seed" + std::to_string(options.seed);
-  manifest.origin = origin;
+  manifest.origin = simulated.origin;
   WriteManifest(manifest, (folder / "survey.yaml").string());
   summary.total_seconds = seconds_since(start);
   LOG(INFO) << summary.BriefReport();

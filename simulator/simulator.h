@@ -40,6 +40,9 @@ struct SimulationOptions {
   // Name of the preset the options came from (informational: survey name and
   // truth/meta.json). ApplyPreset sets it.
   std::string preset = "custom";
+  // What the random preset drew: the kind of survey (RandomKinds()), ""
+  // for the other presets (informational: truth/meta.json).
+  std::string scenario;
   // Seed of every random choice. Same seed and options -> identical files.
   uint64_t seed = 1;
 
@@ -272,9 +275,30 @@ struct SimulationOptions {
 //   ambiguity  drift of ~1 m ACROSS the road, i.e. one band period along
 //              the bands' repetition direction.
 //   large      10 km, 80 crossings, render_images = false (benchmarks).
+//   random     every knob drawn from the seed (DrawRandomOptions).
 // Returns "" or an error naming the known presets. Keeps `seed`.
 std::string ApplyPreset(const std::string& name, SimulationOptions* options);
 std::vector<std::string> PresetNames();
+
+// The random preset (issue 17): a survey of one kind (RandomKinds(): the
+// family of faults it emphasises, "mixed" for all at once) with every knob
+// the contract allows drawn from `seed`: place (four quadrants, high
+// latitudes), heading (cardinal and in between), street (60 m with 2
+// crossings to 1.5 km, 5-12 bands, skew up to 30 degrees, band lengths
+// 2.5-6 m), database error and faults, parked vehicles, GNSS/INS error,
+// rig, rates and exposure spacing. Deterministic in `seed`.
+struct RandomPresetLimits {
+  // Road length range (the geometry sweep's ctest keeps surveys short).
+  double min_road_length_m = 60.0;
+  double max_road_length_m = 1500.0;
+};
+std::vector<std::string> RandomKinds();
+// Sets `options` (render_images and threads stay at their defaults).
+// Returns "" or why the limits are invalid.
+std::string DrawRandomOptions(uint64_t seed, const RandomPresetLimits& limits,
+                              SimulationOptions* options);
+// The drawn knobs in short, for a sweep's log line.
+std::string RandomOptionsBrief(const SimulationOptions& options);
 
 // Sets one field from "key=value" (every field of SimulationOptions: the
 // CLI's --set). Booleans take true/false/1/0, pixel_depth takes 8 or 16.
