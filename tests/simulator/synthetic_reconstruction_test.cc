@@ -1,0 +1,195 @@
+// The synthetic truth of tests/support (issue 17's geometry sweep): the
+// random preset, the reconstruction synthesised from a simulated survey's
+// truth, and the emulated paint probe, against the truth they come from.
+#include "tests/support/synthetic_reconstruction.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "simulator/simulated_survey.h"
+#include "simulator/simulator.h"
+
+namespace zebrageo::support {
+namespace {
+
+sim::SimulatedSurvey ShortDemo() {
+  SimulationOptions options;
+  options.seed = 3;
+  EXPECT_EQ(ApplyPreset("demo", &options), "");
+  options.road_length_m = 120.0;
+  options.num_crossings = 2;
+  options.num_stale_crossings = 0;
+  options.render_images = false;
+  return sim::MakeSimulatedSurvey(options);
+}
+
+TEST(RandomPreset, IsDeterministicValidAndCoversTheContract) {
+  std::set<std::string> kinds;
+  int south = 0, west = 0, high_latitude = 0, near_north = 0, short_streets = 0;
+  for (uint64_t seed = 1; seed <= 200; ++seed) {
+    SimulationOptions a, b;
+    a.seed = b.seed = seed;
+    ASSERT_EQ(ApplyPreset("random", &a), "") << seed;
+    ASSERT_EQ(ApplyPreset("random", &b), "") << seed;
+    EXPECT_EQ(OptionValues(a), OptionValues(b)) << seed;
+    EXPECT_EQ(a.Check(), "") << seed;
+    EXPECT_EQ(a.seed, seed);
+    kinds.insert(a.scenario);
+    south += a.origin_lat_deg < 0.0;
+    west += a.origin_lon_deg < 0.0;
+    high_latitude += std::abs(a.origin_lat_deg) >= 60.0;
+    near_north +=
+        std::min(a.start_heading_deg, 360.0 - a.start_heading_deg) < 3.0;
+    short_streets += a.road_length_m <= 150.0 && a.num_crossings == 2;
+    EXPECT_GE(a.stereo_baseline_m, 0.6);
+    EXPECT_LE(a.stereo_baseline_m, 1.5);
+    EXPECT_GE(a.image_width, 1024);
+    EXPECT_GE(a.road_length_m, 60.0);
+    EXPECT_LE(a.road_length_m, 1500.0);
+  }
+  EXPECT_EQ(kinds.size(), RandomKinds().size());
+  EXPECT_GT(south, 60);
+  EXPECT_GT(west, 60);
+  EXPECT_GT(high_latitude, 20);
+  EXPECT_GT(near_north, 10);
+  EXPECT_GT(short_streets, 50);
+}
+
+TEST(RandomPreset, LimitsTheRoadLength) {
+  RandomPresetLimits limits;
+  limits.max_road_length_m = 200.0;
+  for (uint64_t seed = 1; seed <= 50; ++seed) {
+    SimulationOptions o;
+    ASSERT_EQ(DrawRandomOptions(seed, limits, &o), "");
+    EXPECT_LE(o.road_length_m, 200.0);
+  }
+  limits.min_road_length_m = 20.0;
+  SimulationOptions o;
+  EXPECT_NE(DrawRandomOptions(1, limits, &o), "");
+}
+
+TEST(HiddenByVehicle, BlocksRaysThroughABoxOnly) {
+  sim::World world;
+  sim::ParkedVehicle vehicle;
+  vehicle.box.centre = Eigen::Vector2d(5.0, 0.0);
+  vehicle.box.half_u = 2.0;
+  vehicle.box.half_v = 0.9;
+  vehicle.box.z0 = 0.0;
+  vehicle.box.z1 = 1.5;
+  world.vehicles.push_back(vehicle);
+  const Eigen::Vector3d camera(0.0, 0.0, 2.5);
+  EXPECT_TRUE(HiddenByVehicle(world, camera, {10.0, 0.0, 0.0}));
+  EXPECT_FALSE(HiddenByVehicle(world, camera, {10.0, 3.0, 0.0}));
+  // Over the roof: the ray at x = 3..7 is above 1.5 m.
+  EXPECT_FALSE(HiddenByVehicle(world, {0.0, 0.0, 4.0}, {10.0, 0.0, 1.6}));
+  // The end point itself may touch the box (a band at the wheel).
+  EXPECT_FALSE(HiddenByVehicle(world, camera, {3.0, 0.0, 1.0}));
+}
+
+TEST(SynthesiseReconstruction, BandsAreTheTruthWithinTheirNoiseAndInView) {
+  const sim::SimulatedSurvey survey = ShortDemo();
+  ReconstructionModel model;
+  model.cut_short_probability = 0.0;
+  model.hidden_end_probability = 0.0;
+  const SyntheticReconstruction rec =
+      SynthesiseReconstruction(survey, model, 7);
+  ASSERT_GT(rec.views_reconstructed, 25);
+  const std::map<int64_t, Pose> poses = TruePoses(survey);
+  int near_views = 0;
+  double sum_sq = 0.0;
+  int count = 0;
+  for (const ReconstructedVertex& v : rec.vertices) {
+    const SyntheticBandTruth& truth = rec.truth_of_band.at(v.band_id);
+    const sim::Band& band = survey.world.bands[truth.world_band];
+    const Eigen::Vector3d p = poses.at(v.exposure_id).T_enu_body() * v.p_body;
+    double nearest = 1e9;
+    for (const Eigen::Vector3d& corner : band.corners) {
+      nearest = std::min(nearest, (p - corner).norm());
+    }
+    // 5 sigma along the ray at 15 m (2.6 cm), plus the inferred ends.
+    EXPECT_LT(nearest, truth.inferred_end ? 0.25 : 0.14) << v.band_id;
+    EXPECT_LE(truth.range_m, model.max_range_m);
+    EXPECT_GE(v.uv_left.x(), model.margin_px - 2.0);
+    if (truth.range_m < 8.0 && !truth.inferred_end) {
+      sum_sq += nearest * nearest;
+      ++count;
+      near_views += v.vertex == 0;
+    }
+  }
+  ASSERT_GT(count, 0);
+  // 0.5 cm along the ray at 5 m: within 8 m the RMS is a centimetre or less.
+  EXPECT_LT(std::sqrt(sum_sq / count), 0.012);
+  EXPECT_GE(near_views, 5);
+}
+
+TEST(SynthesiseReconstruction, RecallFallsWithRange) {
+  const sim::SimulatedSurvey survey = ShortDemo();
+  ReconstructionModel all;
+  all.near_recall = 1.0;
+  all.far_recall = 1.0;
+  ReconstructionModel far_poor = all;
+  far_poor.far_recall = 0.3;
+  const SyntheticReconstruction a = SynthesiseReconstruction(survey, all, 7);
+  const SyntheticReconstruction b =
+      SynthesiseReconstruction(survey, far_poor, 7);
+  auto count_far = [](const SyntheticReconstruction& r) {
+    int far = 0;
+    for (const auto& [id, truth] : r.truth_of_band) {
+      far += truth.range_m > 11.0 && !truth.cut_short;
+    }
+    return far;
+  };
+  ASSERT_GT(count_far(a), 20);
+  const double share = static_cast<double>(count_far(b)) / count_far(a);
+  EXPECT_GT(share, 0.15);
+  EXPECT_LT(share, 0.5);
+}
+
+TEST(TruthPaintProbe, PaintOnABandBareRoadBeyondTheCrossingUnknownAlone) {
+  const sim::SimulatedSurvey survey = ShortDemo();
+  ReconstructionModel model;
+  model.probe_unknown_share = 0.0;
+  const TruthPaintProbe probe(survey, model, 1);
+  const std::map<int64_t, Pose> poses = TruePoses(survey);
+  // An exposure 8-12 m before the first crossing, with the true pose (so
+  // the database band is where the street's is).
+  const sim::Crossing& crossing = survey.world.crossings.at(0);
+  int64_t exposure_id = -1;
+  for (const sim::ExposureEvent& e : survey.motion.exposures) {
+    if (crossing.s_m - e.s_m > 8.0 && crossing.s_m - e.s_m < 12.0) {
+      exposure_id = e.exposure_id;
+    }
+  }
+  ASSERT_GE(exposure_id, 0);
+  const Pose& pose = poses.at(exposure_id);
+  std::vector<BandCornersEnu> seen;
+  std::vector<const sim::Band*> bands;
+  for (const sim::Band& band : survey.world.bands) {
+    if (band.crossing != 0) continue;
+    seen.push_back(band.corners);
+    bands.push_back(&band);
+  }
+  ASSERT_GE(bands.size(), 4u);
+  // A middle band: in view from there.
+  const BandCornersEnu& middle = bands[bands.size() / 2]->corners;
+  EXPECT_EQ(probe.Classify(exposure_id, pose, middle, seen),
+            PaintEvidence::kPaint);
+  EXPECT_EQ(probe.Classify(exposure_id, pose, middle, {}),
+            PaintEvidence::kUnknown);
+  // Half a period beside it: the gap between two bands, bare road.
+  BandCornersEnu gap = middle;
+  auto centre = [](const BandCornersEnu& q) {
+    return Eigen::Vector3d(0.25 * (q[0] + q[1] + q[2] + q[3]));
+  };
+  const Eigen::Vector3d to_next =
+      centre(bands[bands.size() / 2 + 1]->corners) - centre(middle);
+  for (Eigen::Vector3d& corner : gap) corner += 0.5 * to_next;
+  EXPECT_EQ(probe.Classify(exposure_id, pose, gap, seen),
+            PaintEvidence::kBareRoad);
+}
+
+}  // namespace
+}  // namespace zebrageo::support
