@@ -24,7 +24,44 @@ enum Purpose : uint64_t {
   kOutageSeed = 23,
   kExposureSeed = 24,
   kRigSeed = 25,
+  kMultipathSeed = 26,
+  kJitterSeed = 27,
 };
+
+// The cross-track switches of a multipath error: num_multipath_switches
+// places along the drive, the sign alternating (the error switches to a
+// new level and back), in order of s.
+std::vector<MultipathSwitch> DrawMultipathSwitches(
+    const SimulationOptions& options, const World& world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kMultipathSeed));
+  std::vector<MultipathSwitch> switches;
+  for (int i = 0; i < options.num_multipath_switches; ++i) {
+    MultipathSwitch m;
+    m.s_m = Uniform(&rng, world.s_drive_start, world.s_drive_end);
+    m.length_m = options.multipath_switch_length_m * Uniform(&rng, 0.5, 1.0);
+    m.cross_track_m = options.multipath_jump_m * Uniform(&rng, 0.7, 1.3);
+    switches.push_back(m);
+  }
+  std::sort(switches.begin(), switches.end(),
+            [](const MultipathSwitch& a, const MultipathSwitch& b) {
+              return a.s_m < b.s_m;
+            });
+  const double first_sign = Bernoulli(&rng, 0.5) ? 1.0 : -1.0;
+  for (size_t i = 0; i < switches.size(); ++i) {
+    switches[i].cross_track_m *= (i % 2 == 0 ? first_sign : -first_sign);
+  }
+  return switches;
+}
+
+// The cross-track error of the switches at road position s.
+double MultipathError(const std::vector<MultipathSwitch>& switches, double s) {
+  double error = 0.0;
+  for (const MultipathSwitch& m : switches) {
+    error += m.cross_track_m *
+             SmoothStep(m.s_m - 0.5 * m.length_m, m.s_m + 0.5 * m.length_m, s);
+  }
+  return error;
+}
 
 // A smooth random signal: a sum of sinusoids with periods in
 // [min_period, 4 min_period], scaled so that its peak over `times` is 1.
@@ -180,6 +217,17 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
     motion.outage_end_time = t0 + outage_end;
   }
 
+  motion.multipath_switches = DrawMultipathSwitches(options, world);
+  // Sample-rate jitter: AR(1) per horizontal axis, its step sized for the
+  // direction of travel (speed * dt per sample) to depart from the heading
+  // by jitter_direction_deg RMS.
+  std::mt19937_64 jitter_rng(SubSeed(options.seed, kJitterSeed));
+  const double jitter_step_m =
+      options.vehicle_speed_mps * dt *
+      std::tan(options.jitter_direction_deg * kDegToRad);
+  const double jitter_decay = std::exp(-dt / options.jitter_correlation_s);
+  Eigen::Vector2d jitter = Eigen::Vector2d::Zero();
+
   motion.truth.reserve(n);
   motion.measured.reserve(n);
   for (int k = 0; k < n; ++k) {
@@ -215,6 +263,15 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
     const Eigen::Vector2d normal = road.LeftNormal(sk);
     const Eigen::Vector2d horizontal = along(t) * tangent + across(t) * normal;
     Eigen::Vector3d error(horizontal.x(), horizontal.y(), vertical(t));
+    if (!motion.multipath_switches.empty()) {
+      error.head<2>() += MultipathError(motion.multipath_switches, sk) * normal;
+    }
+    if (jitter_step_m > 0.0) {
+      jitter = jitter_decay * jitter +
+               Eigen::Vector2d(Gaussian(&jitter_rng, jitter_step_m),
+                               Gaussian(&jitter_rng, jitter_step_m));
+      error.head<2>() += jitter;
+    }
     double outage_fraction = 0.0;
     double extra_heading = 0.0;
     if (has_outage && t >= outage_begin && t < outage_end) {

@@ -28,6 +28,14 @@ struct ExposureEvent {
   double s_m = 0.0;  // road s of the vehicle at that time
 };
 
+// A switch of the cross-track error (multipath): by cross_track_m (signed,
+// along the road's left normal) over length_m of travel centred on s_m.
+struct MultipathSwitch {
+  double s_m = 0.0;
+  double length_m = 0.0;
+  double cross_track_m = 0.0;
+};
+
 struct VehicleMotion {
   std::vector<TrajectorySample> truth;     // true, sd_* = 0
   std::vector<TrajectorySample> measured;  // true + error, sd_* optimistic
@@ -37,6 +45,7 @@ struct VehicleMotion {
   std::vector<Eigen::Vector3d> position_error_enu;
   std::vector<Eigen::Vector3d> attitude_error_rad;
   std::vector<ExposureEvent> exposures;
+  std::vector<MultipathSwitch> multipath_switches;
   double outage_begin_time = 0.0;  // both 0 without an outage
   double outage_end_time = 0.0;
 };

@@ -78,6 +78,7 @@ const std::vector<Field>& Fields() {
       ZEBRAGEO_SIM_FIELD(facade_gap_probability),
       ZEBRAGEO_SIM_FIELD(parked_vehicles_per_100m),
       ZEBRAGEO_SIM_FIELD(occluding_vehicle_probability),
+      ZEBRAGEO_SIM_FIELD(end_band_vehicle_probability),
       ZEBRAGEO_SIM_FIELD(shadows),
       ZEBRAGEO_SIM_FIELD(sun_elevation_deg),
       ZEBRAGEO_SIM_FIELD(sun_azimuth_deg),
@@ -126,6 +127,11 @@ const std::vector<Field>& Fields() {
       ZEBRAGEO_SIM_FIELD(outage_duration_s),
       ZEBRAGEO_SIM_FIELD(outage_drift_m),
       ZEBRAGEO_SIM_FIELD(gnss_return_jump_m),
+      ZEBRAGEO_SIM_FIELD(num_multipath_switches),
+      ZEBRAGEO_SIM_FIELD(multipath_jump_m),
+      ZEBRAGEO_SIM_FIELD(multipath_switch_length_m),
+      ZEBRAGEO_SIM_FIELD(jitter_direction_deg),
+      ZEBRAGEO_SIM_FIELD(jitter_correlation_s),
       ZEBRAGEO_SIM_FIELD(reported_sd_horizontal_m),
       ZEBRAGEO_SIM_FIELD(reported_sd_vertical_m),
       ZEBRAGEO_SIM_FIELD(reported_sd_tilt_deg),
@@ -139,6 +145,8 @@ const std::vector<Field>& Fields() {
       ZEBRAGEO_SIM_FIELD(num_missing_bands),
       ZEBRAGEO_SIM_FIELD(num_repainted_crossings),
       ZEBRAGEO_SIM_FIELD(repaint_shift_m),
+      ZEBRAGEO_SIM_FIELD(num_missing_end_bands),
+      ZEBRAGEO_SIM_FIELD(num_missing_interior_bands),
       ZEBRAGEO_SIM_FIELD(database_line_gap_share),
       ZEBRAGEO_SIM_FIELD(num_moved_lines),
       ZEBRAGEO_SIM_FIELD(num_removed_stop_lines),
@@ -330,6 +338,8 @@ std::string SimulationOptions::Check() const {
   c.Range("parked_vehicles_per_100m", parked_vehicles_per_100m, 0.0, 20.0);
   c.Range("occluding_vehicle_probability", occluding_vehicle_probability, 0.0,
           1.0);
+  c.Range("end_band_vehicle_probability", end_band_vehicle_probability, 0.0,
+          1.0);
   c.Range("sun_elevation_deg", sun_elevation_deg, 5.0, 90.0);
   c.Range("sun_azimuth_deg", sun_azimuth_deg, -360.0, 360.0);
   c.Range("vehicle_speed_mps", vehicle_speed_mps, 1.0, 40.0);
@@ -375,6 +385,11 @@ std::string SimulationOptions::Check() const {
   c.Range("outage_duration_s", outage_duration_s, 0.0, 1e6);
   c.Range("outage_drift_m", outage_drift_m, 0.0, 1000.0);
   c.Range("gnss_return_jump_m", gnss_return_jump_m, 0.0, 100.0);
+  c.Range("num_multipath_switches", num_multipath_switches, 0, 100000);
+  c.Range("multipath_jump_m", multipath_jump_m, 0.0, 20.0);
+  c.Range("multipath_switch_length_m", multipath_switch_length_m, 1.0, 1000.0);
+  c.Range("jitter_direction_deg", jitter_direction_deg, 0.0, 30.0);
+  c.Range("jitter_correlation_s", jitter_correlation_s, 0.1, 1000.0);
   c.Range("reported_sd_horizontal_m", reported_sd_horizontal_m, 0.0, 100.0);
   c.Range("reported_sd_vertical_m", reported_sd_vertical_m, 0.0, 100.0);
   c.Range("reported_sd_tilt_deg", reported_sd_tilt_deg, 0.0, 10.0);
@@ -389,16 +404,20 @@ std::string SimulationOptions::Check() const {
   c.Range("num_missing_bands", num_missing_bands, 0, 100000);
   c.Range("num_repainted_crossings", num_repainted_crossings, 0, 100000);
   c.Range("repaint_shift_m", repaint_shift_m, 0.0, 2.0);
+  c.Range("num_missing_end_bands", num_missing_end_bands, 0, 100000);
+  c.Range("num_missing_interior_bands", num_missing_interior_bands, 0, 100000);
   c.Range("database_line_gap_share", database_line_gap_share, 0.0, 0.9);
   c.Range("num_moved_lines", num_moved_lines, 0, 100000);
   c.Range("num_removed_stop_lines", num_removed_stop_lines, 0, 100000);
 
   // Consistency between fields.
-  const int faulty =
-      num_missing_crossings + num_missing_bands + num_repainted_crossings;
+  const int faulty = num_missing_crossings + num_missing_bands +
+                     num_repainted_crossings + num_missing_end_bands +
+                     num_missing_interior_bands;
   c.Require(faulty <= num_crossings,
             "num_missing_crossings + num_missing_bands + "
-            "num_repainted_crossings = " +
+            "num_repainted_crossings + num_missing_end_bands + "
+            "num_missing_interior_bands = " +
                 std::to_string(faulty) + ": must be <= num_crossings = " +
                 std::to_string(num_crossings));
   const int positions = num_crossings + num_stale_crossings;
@@ -425,6 +444,12 @@ std::string SimulationOptions::Check() const {
     c.Require(fit >= 2, "road_width_m = " + Fmt(road_width_m) +
                             ": must fit at least 2 bands of band_width_m + "
                             "band_gap_m");
+  }
+  if (num_missing_interior_bands > 0) {
+    c.Require(
+        min_bands_per_crossing >= 3,
+        "min_bands_per_crossing = " + std::to_string(min_bands_per_crossing) +
+            ": must be >= 3 when num_missing_interior_bands > 0");
   }
   if (num_missing_bands > 0) {
     c.Require(

@@ -152,6 +152,25 @@ void DrawTrajectoryError(std::mt19937_64* rng, const std::string& kind,
     o->outage_drift_m = Uniform(rng, 0.3, 3.0);
     o->gnss_return_jump_m = Uniform(rng, 0.0, 0.5);
   }
+  // Multipath: the cross-track error switching by about a metre within
+  // 10-40 m of travel, about once per 150 m.
+  const bool multipath =
+      kind == "multipath" || (kind == "mixed" && Bernoulli(rng, 0.3));
+  if (multipath) {
+    o->num_multipath_switches =
+        std::max(1, static_cast<int>(std::lround(o->road_length_m / 150.0 *
+                                                 Uniform(rng, 0.5, 1.5))));
+    o->multipath_jump_m = Uniform(rng, 0.6, 1.5);
+    o->multipath_switch_length_m = Uniform(rng, 10.0, 40.0);
+  }
+  // Positions jittering at the sample rate: the direction of travel departs
+  // from the heading by a few degrees RMS.
+  const bool jitter =
+      kind == "jitter" || (kind == "mixed" && Bernoulli(rng, 0.3));
+  if (jitter) {
+    o->jitter_direction_deg = Uniform(rng, 2.0, 8.0);
+    o->jitter_correlation_s = Uniform(rng, 1.0, 5.0);
+  }
   // What the solution claims: optimistic, or honest about its drift.
   if (Bernoulli(rng, 0.5)) {
     o->reported_sd_horizontal_m = Uniform(rng, 0.01, 0.05);
@@ -189,10 +208,15 @@ void DrawDatabase(std::mt19937_64* rng, const std::string& kind,
     budget -= k;
     return k;
   };
-  o->num_missing_bands = o->min_bands_per_crossing >= 3 ? take(count(db)) : 0;
+  o->num_missing_end_bands = take(count(db));
+  o->num_missing_interior_bands = take(count(db) / 2);
+  o->num_missing_bands = take(count(db) / 2);
   o->num_missing_crossings = take(count(db) / 2);
   o->num_repainted_crossings = take(count(street) / 2);
-  o->repaint_shift_m = Uniform(rng, 0.25, 1.0);
+  // Along the road 0.6-1 times this: 0.2-1 m.
+  o->repaint_shift_m = Uniform(rng, 0.33, 1.0);
+  o->end_band_vehicle_probability =
+      street ? Uniform(rng, 0.2, 0.6) : Uniform(rng, 0.0, 0.1);
   o->num_stale_crossings = count(street) / 2;
   o->database_line_gap_share = Uniform(rng, 0.0, 0.3);
 }
@@ -276,9 +300,23 @@ std::string RandomOptionsBrief(const SimulationOptions& o) {
     out.precision(0);
     out << ", outage " << o.outage_duration_s << " s";
   }
+  if (o.num_multipath_switches > 0) {
+    out.precision(1);
+    out << ", multipath " << o.num_multipath_switches << "x"
+        << o.multipath_jump_m << " m";
+  }
+  if (o.jitter_direction_deg > 0.0) {
+    out.precision(1);
+    out << ", jitter " << o.jitter_direction_deg << " deg";
+  }
   out.precision(2);
   out << ", db " << o.database_sigma_xy_m << "/" << o.database_max_offset_m;
-  if (o.num_missing_bands) out << ", -band x" << o.num_missing_bands;
+  if (o.num_missing_end_bands)
+    out << ", -end band x" << o.num_missing_end_bands;
+  if (o.num_missing_interior_bands) {
+    out << ", -inner band x" << o.num_missing_interior_bands;
+  }
+  if (o.num_missing_bands) out << ", -last band x" << o.num_missing_bands;
   if (o.num_missing_crossings)
     out << ", -crossing x" << o.num_missing_crossings;
   if (o.num_repainted_crossings) {

@@ -108,7 +108,9 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
     j["in_db"] = c.in_db;
     j["in_street"] = c.in_street;
     j["num_bands"] = c.in_street ? c.num_street_bands : 0;
-    j["num_bands_db"] = c.in_db ? c.num_db_bands : 0;
+    j["num_bands_db"] =
+        c.in_db ? c.num_db_bands - static_cast<int>(c.db_missing_bands.size())
+                : 0;
     j["skew_deg"] = c.skew_deg;
     j["band_length_m"] = c.band_length_m;
     j["band_width_m"] = c.band_width_m;
@@ -126,6 +128,8 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
                             : nlohmann::json(c.missing_band_kind);
     j["stop_line"] = c.stop_line;
     j["occluded_by_vehicle"] = c.occluded_by_vehicle;
+    if (!c.db_missing_bands.empty()) j["db_missing_bands"] = c.db_missing_bands;
+    if (!c.end_band_vehicle.empty()) j["end_band_vehicle"] = c.end_band_vehicle;
     crossings.push_back(j);
     if (!c.in_db) faults["missing_crossings"].push_back(c.id);
     if (!c.in_street) faults["stale_crossings"].push_back(c.id);
@@ -139,6 +143,13 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
     } else if (c.missing_band_kind == "missing_in_db") {
       faults["missing_bands"].push_back({{"crossing_id", c.id},
                                          {"band", c.num_design_bands},
+                                         {"kind", c.missing_band_kind},
+                                         {"in_db", false},
+                                         {"in_street", true}});
+    }
+    for (int band : c.db_missing_bands) {
+      faults["missing_bands"].push_back({{"crossing_id", c.id},
+                                         {"band", band},
                                          {"kind", c.missing_band_kind},
                                          {"in_db", false},
                                          {"in_street", true}});
@@ -177,6 +188,14 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
     error["outage_time"] = {motion.outage_begin_time, motion.outage_end_time};
   } else {
     error["outage_time"] = nullptr;
+  }
+  if (!motion.multipath_switches.empty()) {
+    error["multipath_switches"] = nlohmann::json::array();
+  }
+  for (const sim::MultipathSwitch& m : motion.multipath_switches) {
+    error["multipath_switches"].push_back({{"s_m", m.s_m},
+                                           {"length_m", m.length_m},
+                                           {"cross_track_m", m.cross_track_m}});
   }
   meta["trajectory_error"] = error;
 

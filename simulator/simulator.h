@@ -131,6 +131,9 @@ struct SimulationOptions {
   // Probability that a vehicle is parked just before a crossing, hiding its
   // outer bands from some viewpoints.
   double occluding_vehicle_probability = 0.3;
+  // Probability per crossing of a vehicle parked at the kerb over its first
+  // or its last band, hiding that band from every viewpoint.
+  double end_band_vehicle_probability = 0.0;
   // Cast shadows of buildings and vehicles (darker ground regions).
   bool shadows = true;
   double sun_elevation_deg = 45.0;
@@ -225,6 +228,21 @@ struct SimulationOptions {
   // Extra step of the error when GNSS returns (random direction), decaying
   // with a 20 s time constant.
   double gnss_return_jump_m = 0.15;
+  // Multipath: sudden switches of the cross-track error, at
+  // num_multipath_switches random places of the drive, each by
+  // multipath_jump_m (times 0.7-1.3, the sign alternating so the error
+  // switches back and forth) within multipath_switch_length_m of travel.
+  int num_multipath_switches = 0;
+  double multipath_jump_m = 1.0;
+  double multipath_switch_length_m = 40.0;
+  // Sample-rate jitter: a random walk of the measured positions at the
+  // trajectory rate (mean-reverting with time constant
+  // jitter_correlation_s), sized so that the direction of travel between
+  // consecutive samples departs from the heading by about
+  // jitter_direction_deg RMS at the mean speed (an unsmoothed GNSS, or
+  // GNSS + dead-reckoning, solution). 0 = none.
+  double jitter_direction_deg = 0.0;
+  double jitter_correlation_s = 2.0;
   // What the solution claims (sd_* columns): optimistic. During an outage
   // the claimed horizontal sd grows by at most 0.2 m.
   double reported_sd_horizontal_m = 0.03;
@@ -252,6 +270,13 @@ struct SimulationOptions {
   int num_missing_bands = 0;
   int num_repainted_crossings = 0;
   double repaint_shift_m = 0.3;
+  // Crossings whose database copy lacks a band the street has: its first or
+  // its last band (num_missing_end_bands), or one strictly inside
+  // (num_missing_interior_bands). The database keeps the street's band
+  // numbers: lacking band 1 it holds bands 2..n, lacking band k 1..k-1,
+  // k+1..n (a gap in the numbering, as field databases have).
+  int num_missing_end_bands = 0;
+  int num_missing_interior_bands = 0;
   // Faults of the database's lines (lane and stop lines): a share of each
   // lane line's length missing from the database (gaps of 10-30 m); stretches
   // of 30-60 m of a lane line repainted 0.25-0.45 m across the road since

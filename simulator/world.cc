@@ -128,6 +128,11 @@ void PlaceCrossings(const SimulationOptions& options, World* world) {
   assign(options.num_missing_crossings, "missing");
   assign(options.num_repainted_crossings, "repainted");
   assign(options.num_missing_bands, "missing_band");
+  assign(options.num_missing_end_bands, "missing_end_band");
+  assign(options.num_missing_interior_bands, "missing_interior_band");
+  // The database's band gaps draw from their own generator: the crossings
+  // of the other presets do not change with these knobs.
+  std::mt19937_64 gap_rng(SubSeed(options.seed, kCrossingSeed, 7));
 
   const double width = road.width_m();
   const double period = options.band_width_m + options.band_gap_m;
@@ -198,6 +203,12 @@ void PlaceCrossings(const SimulationOptions& options, World* world) {
         c.missing_band_kind = "missing_in_db";
         c.num_db_bands = c.num_design_bands - 1;
       }
+    } else if (role[i] == "missing_end_band" && c.num_design_bands >= 2) {
+      c.missing_band_kind = "end_missing_in_db";
+      c.db_missing_bands = {Bernoulli(&gap_rng, 0.5) ? 1 : c.num_design_bands};
+    } else if (role[i] == "missing_interior_band" && c.num_design_bands >= 3) {
+      c.missing_band_kind = "interior_missing_in_db";
+      c.db_missing_bands = {UniformInt(&gap_rng, 2, c.num_design_bands - 1)};
     }
     c.origin_xy = road.Centre(s_design) + c.repaint_shift_xy;
     c.s_m = s_design + c.repaint_shift_xy.dot(c.t);
@@ -518,6 +529,45 @@ void ParkVehicles(const SimulationOptions& options, World* world) {
   }
 }
 
+// Vehicles parked at the kerb over a crossing's first or last band (after
+// every other vehicle, from their own generator: the other presets' streets
+// do not change with end_band_vehicle_probability).
+void ParkOverEndBands(const SimulationOptions& options, World* world) {
+  if (options.end_band_vehicle_probability <= 0.0) return;
+  std::mt19937_64 rng(SubSeed(options.seed, kVehicleSeed, 2));
+  const Road& road = world->road;
+  const double half_width = 0.5 * road.width_m();
+  for (Crossing& c : world->crossings) {
+    const bool want = Bernoulli(&rng, options.end_band_vehicle_probability);
+    const bool first = Bernoulli(&rng, 0.5);
+    const double length = Uniform(&rng, 4.0, 4.8);
+    const double along = Uniform(&rng, -1.0, 1.0);
+    // Its inner side 0.8-1.2 m from the kerb: over the outer band (0.25 m
+    // from the kerb, 0.5 m wide), not over the next one.
+    const double inner = Uniform(&rng, 0.8, 1.2);
+    if (!want || !c.in_street || c.num_street_bands < 2) continue;
+    const int band = first ? 1 : c.num_street_bands;
+    const double o =
+        c.first_offset_m + (band - 1) * c.band_period_m + 0.5 * c.band_width_m;
+    const double side = o < 0.0 ? -1.0 : 1.0;
+    // Only an outer band at the kerb can be under a parked vehicle, and not
+    // where the survey vehicle drives (its lane, with 1.8 m to spare).
+    if (half_width - std::abs(o) > 1.0) continue;
+    if (side * world->lane_offset_m > 0.0 &&
+        half_width - inner < std::abs(world->lane_offset_m) + 1.8) {
+      continue;
+    }
+    const double s = c.s_m + o * c.tan_skew + along;
+    ParkedVehicle v = MakeVehicle(road, s, side, length, &rng);
+    const double l_centre = side * (half_width - inner + v.box.half_v);
+    v.box.centre = road.Centre(s) + l_centre * road.LeftNormal(s);
+    v.box.z0 = road.Height(s, l_centre) - 0.05;
+    v.occludes_crossing = true;
+    c.end_band_vehicle = first ? "first" : "last";
+    world->vehicles.push_back(v);
+  }
+}
+
 void CastShadows(const SimulationOptions& options, World* world) {
   if (!options.shadows || world->sun_enu.z() < 0.05) return;
   const Road& road = world->road;
@@ -627,6 +677,7 @@ World BuildWorld(const SimulationOptions& options) {
   PlaceSmallMarks(options, &world);
   BuildFacades(options, &world);
   ParkVehicles(options, &world);
+  ParkOverEndBands(options, &world);
   CastShadows(options, &world);
   for (Shadow& shadow : world.shadows) shadow.Finish();
   return world;
@@ -771,6 +822,10 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
     if (!c.in_db) continue;
     const Eigen::Vector2d origin = c.origin_xy - c.repaint_shift_xy;
     for (int k = 1; k <= c.num_db_bands; ++k) {
+      if (std::find(c.db_missing_bands.begin(), c.db_missing_bands.end(), k) !=
+          c.db_missing_bands.end()) {
+        continue;  // the gap keeps the street's numbering
+      }
       const auto corners = DesignBandCorners(world.road, c, k, origin);
       RoadmarkBand out;
       out.crossing_id = c.id;

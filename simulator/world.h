@@ -100,15 +100,22 @@ struct Crossing {
   std::vector<int> ring_start;  // per design band, 0..3
   bool in_street = true;
   bool in_db = true;
-  int num_street_bands = 0;       // bands 1..num_street_bands are painted
-  int num_db_bands = 0;           // bands 1..num_db_bands are in the database
-  std::string missing_band_kind;  // "", "worn_in_street", "missing_in_db"
+  int num_street_bands = 0;  // bands 1..num_street_bands are painted
+  int num_db_bands = 0;      // bands 1..num_db_bands are in the database
+  // "", "worn_in_street", "missing_in_db" (the last band),
+  // "end_missing_in_db", "interior_missing_in_db" (db_missing_bands).
+  std::string missing_band_kind;
+  // Band numbers of 1..num_db_bands the database lacks (it keeps the
+  // street's numbering, with a gap).
+  std::vector<int> db_missing_bands;
   bool repainted = false;
   // Street origin minus database origin (horizontal, metres).
   Eigen::Vector2d repaint_shift_xy = Eigen::Vector2d::Zero();
   Eigen::Vector3d db_offset_enu = Eigen::Vector3d::Zero();
   bool stop_line = false;
   bool occluded_by_vehicle = false;
+  // "first" or "last" when a vehicle is parked over that band, else "".
+  std::string end_band_vehicle;
   // Road s-range covered by the painted area (with skew), street position.
   double s_min = 0.0, s_max = 0.0;
   uint64_t salt = 0;

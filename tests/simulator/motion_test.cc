@@ -161,3 +161,72 @@ TEST(Rig, CamerasLookForwardAndDownOneMetreApart) {
 
 }  // namespace
 }  // namespace zebrageo::sim
+
+namespace zebrageo::sim {
+namespace {
+
+TEST(Motion, MultipathSwitchesTheCrossTrackErrorByAMetreWithinFortyMetres) {
+  SimulationOptions options = MotionOptions();
+  options.drift_along_track_m = 0.05;
+  options.drift_cross_track_m = 0.05;
+  options.num_multipath_switches = 3;
+  options.multipath_jump_m = 1.0;
+  options.multipath_switch_length_m = 40.0;
+  const World world = BuildWorld(options);
+  const VehicleMotion motion = SimulateMotion(options, world, FrameOf(options));
+  ASSERT_EQ(motion.multipath_switches.size(), 3u);
+  for (const MultipathSwitch& m : motion.multipath_switches) {
+    // Cross-track error 25 m before and after the switch's centre.
+    double before = 0.0, after = 0.0;
+    for (size_t k = 0; k < motion.s_m.size(); ++k) {
+      const Eigen::Vector2d normal = world.road.LeftNormal(motion.s_m[k]);
+      const double cross = motion.position_error_enu[k].head<2>().dot(normal);
+      if (std::abs(motion.s_m[k] - (m.s_m - 25.0)) < 0.1) before = cross;
+      if (std::abs(motion.s_m[k] - (m.s_m + 25.0)) < 0.1) after = cross;
+    }
+    if (m.s_m < world.s_drive_start + 25.0 || m.s_m > world.s_drive_end - 25.0)
+      continue;
+    EXPECT_GT(std::abs(after - before), 0.5);
+    EXPECT_LT(std::abs(after - before), 1.6);
+  }
+  // Signs alternate: the error switches there and back.
+  EXPECT_LT(motion.multipath_switches[0].cross_track_m *
+                motion.multipath_switches[1].cross_track_m,
+            0.0);
+}
+
+TEST(Motion, JitterTurnsTheDirectionOfTravelAwayFromTheHeading) {
+  SimulationOptions options = MotionOptions();
+  options.trajectory_rate_hz = 100.0;
+  options.jitter_direction_deg = 6.0;
+  const World world = BuildWorld(options);
+  const LocalFrame frame = FrameOf(options);
+  const VehicleMotion motion = SimulateMotion(options, world, frame);
+  double sum_sq = 0.0;
+  int count = 0;
+  for (size_t k = 1; k < motion.measured.size(); ++k) {
+    const Eigen::Vector3d step =
+        frame.EnuFromGeodetic(motion.measured[k].position) -
+        frame.EnuFromGeodetic(motion.measured[k - 1].position);
+    const Eigen::Vector3d true_step =
+        frame.EnuFromGeodetic(motion.truth[k].position) -
+        frame.EnuFromGeodetic(motion.truth[k - 1].position);
+    const double angle =
+        std::atan2(step.x() * true_step.y() - step.y() * true_step.x(),
+                   step.head<2>().dot(true_step.head<2>()));
+    sum_sq += angle * angle;
+    ++count;
+  }
+  const double rms_deg = std::sqrt(sum_sq / count) / kDeg;
+  EXPECT_GT(rms_deg, 4.0);
+  EXPECT_LT(rms_deg, 9.0);
+  // Mean-reverting: the position error stays bounded (decimetres).
+  double max_h = 0.0;
+  for (const Eigen::Vector3d& e : motion.position_error_enu) {
+    max_h = std::max(max_h, e.head<2>().norm());
+  }
+  EXPECT_LT(max_h, options.drift_along_track_m + 1.0);
+}
+
+}  // namespace
+}  // namespace zebrageo::sim

@@ -342,3 +342,100 @@ TEST(World, DatabaseLinesHaveGapsMovedStretchesAndRemovedStopLines) {
 
 }  // namespace
 }  // namespace zebrageo::sim
+
+namespace zebrageo::sim {
+namespace {
+
+TEST(World, DatabaseLackingEndAndInteriorBandsKeepsTheStreetsNumbering) {
+  SimulationOptions options;
+  options.seed = 11;
+  options.road_length_m = 400.0;
+  options.num_crossings = 6;
+  options.num_stale_crossings = 0;
+  options.min_bands_per_crossing = 5;
+  options.num_missing_end_bands = 2;
+  options.num_missing_interior_bands = 2;
+  const World world = BuildWorld(options);
+  const LocalFrame frame(Geodetic{options.origin_lat_deg,
+                                  options.origin_lon_deg, options.origin_h_m});
+  const RoadmarkDatabase database =
+      MakeDatabaseRoadmarks(world, options, frame);
+  const RoadmarkDatabase truth = MakeTruthRoadmarks(world, frame);
+  std::map<std::string, std::set<int>> db_bands, street_bands;
+  for (const RoadmarkBand& b : database.bands) {
+    db_bands[b.crossing_id].insert(b.band);
+  }
+  for (const RoadmarkBand& b : truth.bands) {
+    street_bands[b.crossing_id].insert(b.band);
+  }
+  int end = 0, interior = 0;
+  for (const Crossing& c : world.crossings) {
+    const std::set<int>& street = street_bands[c.id];
+    ASSERT_EQ(static_cast<int>(street.size()), c.num_street_bands);
+    EXPECT_EQ(*street.begin(), 1);
+    if (c.db_missing_bands.empty()) {
+      EXPECT_EQ(db_bands[c.id], street) << c.id;
+      continue;
+    }
+    ASSERT_EQ(c.db_missing_bands.size(), 1u);
+    const int gap = c.db_missing_bands[0];
+    std::set<int> expected = street;
+    expected.erase(gap);
+    EXPECT_EQ(db_bands[c.id], expected) << c.id;
+    if (c.missing_band_kind == "end_missing_in_db") {
+      ++end;
+      EXPECT_TRUE(gap == 1 || gap == c.num_street_bands) << gap;
+    } else {
+      ++interior;
+      EXPECT_EQ(c.missing_band_kind, "interior_missing_in_db");
+      EXPECT_GT(gap, 1);
+      EXPECT_LT(gap, c.num_street_bands);
+    }
+  }
+  EXPECT_EQ(end, 2);
+  EXPECT_EQ(interior, 2);
+}
+
+TEST(World, VehiclesParkOverEndBandsAtTheKerbOutOfTheDrivingLane) {
+  SimulationOptions options;
+  options.seed = 12;
+  options.road_length_m = 600.0;
+  options.road_width_m = 12.0;
+  options.num_crossings = 10;
+  options.occluding_vehicle_probability = 0.0;
+  options.parked_vehicles_per_100m = 0.0;
+  options.end_band_vehicle_probability = 1.0;
+  const World world = BuildWorld(options);
+  int covered = 0;
+  for (const Crossing& c : world.crossings) {
+    if (c.end_band_vehicle.empty()) continue;
+    const int band = c.end_band_vehicle == "first" ? 1 : c.num_street_bands;
+    const Band* end_band = nullptr;
+    for (const Band& b : world.bands) {
+      if (world.crossings[b.crossing].id == c.id && b.band == band) {
+        end_band = &b;
+      }
+    }
+    ASSERT_NE(end_band, nullptr);
+    const Eigen::Vector2d centre =
+        0.25 * (end_band->corners[0] + end_band->corners[1] +
+                end_band->corners[2] + end_band->corners[3])
+                   .head<2>();
+    bool under = false;
+    for (const ParkedVehicle& v : world.vehicles) {
+      const Eigen::Vector2d d = centre - v.box.centre;
+      under |= std::abs(d.dot(v.box.axis_u)) < v.box.half_u &&
+               std::abs(d.dot(v.box.axis_v())) < v.box.half_v;
+      // Never where the survey vehicle drives.
+      double s = 0.0, l = 0.0;
+      ASSERT_TRUE(world.road.ToRoadCoordinates(v.box.centre, c.s_m, &s, &l));
+      EXPECT_GT(std::abs(l - world.lane_offset_m), v.box.half_v + 1.7);
+    }
+    EXPECT_TRUE(under) << c.id << " band " << band;
+    ++covered;
+  }
+  EXPECT_GE(covered, 5);
+}
+
+}  // namespace
+}  // namespace zebrageo::sim
