@@ -23,6 +23,7 @@ struct SimulateArguments {
   std::vector<std::string> overrides;
   bool no_images = false;
   std::string bad;
+  double max_road_length_m = RandomPresetLimits().max_road_length_m;
 };
 
 }  // namespace
@@ -34,7 +35,8 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
       "Write a simulated survey (images, trajectory with GNSS/INS drift, "
       "road-mark database) with its ground truth in truth/.");
   sub->add_option("--preset", args->preset,
-                  "demo, urban, outage, sparse, ambiguity or large")
+                  "demo, urban, outage, sparse, ambiguity, large or random "
+                  "(every knob drawn from the seed)")
       ->capture_default_str();
   sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
   sub->add_option("-o,--output", args->output, "survey folder to write")
@@ -46,14 +48,25 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
                   "write a small broken survey of this kind for the "
                   "bad-input suite (truth/meta.json says what to expect; "
                   "kinds in README.md)");
+  sub->add_option("--max-road-length", args->max_road_length_m,
+                  "random preset: the longest road drawn, metres (from 60)")
+      ->capture_default_str();
   sub->add_flag("--no-images", args->no_images,
                 "write only the geometry (no rendering)");
   commands->push_back(
       {sub, [args] {
          SimulationOptions options;
-         std::string error = ApplyPreset(args->preset, &options);
-         if (!error.empty()) throw UsageError(error);
+         // The random preset draws from the seed: set it first.
          options.seed = args->seed;
+         std::string error;
+         if (args->preset == "random") {
+           RandomPresetLimits limits;
+           limits.max_road_length_m = args->max_road_length_m;
+           error = DrawRandomOptions(args->seed, limits, &options);
+         } else {
+           error = ApplyPreset(args->preset, &options);
+         }
+         if (!error.empty()) throw UsageError(error);
          if (!args->bad.empty()) {
            error = ApplyBadSurveySettings(args->bad, &options);
            if (!error.empty()) throw UsageError(error);
