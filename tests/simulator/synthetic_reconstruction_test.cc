@@ -11,6 +11,7 @@
 
 #include "simulator/simulated_survey.h"
 #include "simulator/simulator.h"
+#include "tests/support/geometry_sweep.h"
 
 namespace zebrageo::support {
 namespace {
@@ -189,6 +190,33 @@ TEST(TruthPaintProbe, PaintOnABandBareRoadBeyondTheCrossingUnknownAlone) {
   for (Eigen::Vector3d& corner : gap) corner += 0.5 * to_next;
   EXPECT_EQ(probe.Classify(exposure_id, pose, gap, seen),
             PaintEvidence::kBareRoad);
+}
+
+// The sweep scores the input trajectory as score_results.py poses does:
+// on demo seed 1 (dumped with geometry_sweep --verbose 1 --preset demo, the
+// scorer says "before: H 48.6 cm, V 2.9 cm, att 0.093 deg (108 cameras)"),
+// and its matches as score_results.py match (a match to a band not in the
+// street, or more than 0.2 m from the named corner, is wrong).
+TEST(GeometrySweep, ScoresTheInputAsScoreResultsDoes) {
+  GeometrySweepOptions options;
+  options.preset = "demo";
+  const GeometryRunResult r = RunGeometrySurvey(1, options);
+  ASSERT_EQ(r.error, "");
+  EXPECT_EQ(r.cameras, 108);
+  EXPECT_NEAR(100 * r.h_before_m, 48.6, 0.05);
+  EXPECT_NEAR(100 * r.v_before_m, 2.9, 0.05);
+  EXPECT_NEAR(r.att_before_deg, 0.093, 0.0005);
+  EXPECT_EQ(r.crossings_matchable, 3);
+  EXPECT_GT(r.bands_reconstructed, 20);
+  EXPECT_EQ(r.right % 4, 0);  // whole bands
+  if (r.usable) {
+    EXPECT_TRUE(std::isfinite(r.h_after_m));
+  }
+  EXPECT_FALSE(r.skipped);
+  options.only_kind = "jitter";
+  EXPECT_EQ(options.Check(), "");
+  options.only_kind = "sideways";
+  EXPECT_NE(options.Check(), "");
 }
 
 }  // namespace

@@ -400,6 +400,14 @@ GeometrySweepSummary Summarise(const std::vector<GeometryRunResult>& results) {
     s.worse_attitude += r.worse_attitude ? 1 : 0;
     s.unusable += r.usable ? 0 : 1;
     s.unusable_with_control += r.UnusableWithControl() ? 1 : 0;
+    std::array<int, 7>& kind = s.by_kind[r.kind];
+    kind[0] += 1;
+    kind[1] += r.wrong;
+    kind[2] += r.worse_position ? 1 : 0;
+    kind[3] += r.worse_attitude ? 1 : 0;
+    kind[4] += r.UnusableWithControl() ? 1 : 0;
+    kind[5] += r.crossings_matched;
+    kind[6] += r.crossings_matchable;
     h_before.push_back(100 * r.h_before_m);
     v_before.push_back(100 * r.v_before_m);
     att_before.push_back(r.att_before_deg);
@@ -471,7 +479,13 @@ std::string GeometrySweepSummary::Report() const {
       << "    V   " << SpreadText(v_after_cm, 1) << " cm ("
       << SpreadText(v_before_cm, 1) << ")\n"
       << "    att " << SpreadText(att_after_deg, 3) << " deg ("
-      << SpreadText(att_before_deg, 3) << ")\n";
+      << SpreadText(att_before_deg, 3) << ")\n"
+      << "  by kind: surveys, wrong matches, worse position, worse attitude, "
+         "exit 3 with control, crossings matched\n";
+  for (const auto& [kind, k] : by_kind) {
+    out << "    " << kind << ": " << k[0] << ", " << k[1] << ", " << k[2]
+        << ", " << k[3] << ", " << k[4] << ", " << k[5] << "/" << k[6] << "\n";
+  }
   return out.str();
 }
 

@@ -25,6 +25,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -123,6 +124,10 @@ struct GeometrySweepSummary {
   // Over the usable runs: median, 95th percentile, worst.
   std::array<double, 3> h_after_cm{}, v_after_cm{}, att_after_deg{};
   std::array<double, 3> h_before_cm{}, v_before_cm{}, att_before_deg{};
+  // Per kind of the random preset: surveys, wrong matches, worse in
+  // position, worse in attitude, unusable with control, crossings matched,
+  // matchable.
+  std::map<std::string, std::array<int, 7>> by_kind;
 
   double MatchedShare() const {
     return crossings_matchable > 0
