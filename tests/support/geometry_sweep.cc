@@ -79,6 +79,11 @@ void ScoreMatches(const sim::SimulatedSurvey& simulated,
       matched.insert(m.crossing_id);
     } else {
       ++result->wrong;
+      const auto band = reconstruction.truth_of_band.find(m.band_id);
+      if (band != reconstruction.truth_of_band.end() &&
+          band->second.cut_short) {
+        ++result->wrong_on_cut_bands;
+      }
       wrong.insert(m.crossing_id + ":" + std::to_string(m.band));
     }
   }
@@ -241,6 +246,9 @@ std::string GeometryRunResult::Line() const {
   std::string flags;
   if (wrong > 0) {
     flags += " WRONG";
+    if (wrong_on_cut_bands > 0) {
+      flags += " (" + std::to_string(wrong_on_cut_bands) + " on cut bands)";
+    }
     for (const std::string& c : wrong_crossings) flags += " " + c;
   }
   if (worse_position) flags += " WORSE-POSITION";
@@ -392,6 +400,7 @@ GeometrySweepSummary Summarise(const std::vector<GeometryRunResult>& results) {
       continue;
     }
     s.wrong_matches += r.wrong;
+    s.wrong_on_cut_bands += r.wrong_on_cut_bands;
     s.surveys_with_wrong_matches += r.wrong > 0 ? 1 : 0;
     s.right_matches += r.right;
     s.crossings_matchable += r.crossings_matchable;
@@ -464,8 +473,8 @@ std::string GeometrySweepSummary::Report() const {
   out << surveys << " surveys, " << Fixed(seconds, 1) << " s of CPU ("
       << Fixed(surveys > 0 ? seconds / surveys : 0.0, 2) << " s each)\n"
       << "  wrong vertex matches " << wrong_matches << " (in "
-      << surveys_with_wrong_matches << " surveys), right " << right_matches
-      << "\n"
+      << surveys_with_wrong_matches << " surveys; " << wrong_on_cut_bands
+      << " on bands cut short), right " << right_matches << "\n"
       << "  crossings matched " << Fixed(100.0 * MatchedShare(), 1) << " % ("
       << crossings_matched << "/" << crossings_matchable << ")\n"
       << "  worse than the input: position " << worse_position << ", attitude "

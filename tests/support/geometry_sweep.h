@@ -63,6 +63,10 @@ struct GeometryRunResult {
   // Matching.
   int wrong = 0;
   int right = 0;
+  // Wrong matches of vertices of bands the synthesis cut short (one end's
+  // vertices 0.25-1 m inside the paint): the band is the right one, its
+  // vertices are not where the database's are.
+  int wrong_on_cut_bands = 0;
   int crossings_matchable = 0;
   int crossings_matched = 0;
   // Matchable crossings that are not repainted: a consistent set exists.
@@ -112,6 +116,7 @@ struct GeometrySweepSummary {
   int surveys = 0;  // run (not skipped)
   int errors = 0;   // exceptions
   int wrong_matches = 0;
+  int wrong_on_cut_bands = 0;
   int surveys_with_wrong_matches = 0;
   int right_matches = 0;
   int crossings_matchable = 0;
