@@ -221,6 +221,135 @@ std::map<int64_t, Pose> TruePoses(const sim::SimulatedSurvey& survey) {
   return poses;
 }
 
+namespace {
+
+// One band seen whole by one stereo pair: its corners (ENU) and pixels.
+struct BandView {
+  int band = -1;  // index into World::bands
+  double range_m = 0.0;
+  std::array<Eigen::Vector3d, 4> corners;
+  std::array<Eigen::Vector2d, 4> uv_left, uv_right;
+};
+
+// False unless every corner of `band` lies in front of both cameras and
+// projects inside both images, and its centre is within range.
+bool SeeWhole(const ReconstructionModel& model, const sim::Band& band,
+              const CameraView& left, const CameraView& right, BandView* view) {
+  view->corners = band.corners;
+  view->range_m = (Centre(band.corners) - left.centre_enu).norm();
+  if (view->range_m > model.max_range_m) return false;
+  for (int k = 0; k < 4; ++k) {
+    if (!ProjectInside(left, band.corners[k], model.min_depth_m,
+                       model.margin_px, &view->uv_left[k]) ||
+        !ProjectInside(right, band.corners[k], model.min_depth_m,
+                       model.margin_px, &view->uv_right[k])) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Everything random about one band view, drawn up front so that one
+// decision does not shift the random stream of the others.
+struct ViewDraws {
+  double recall = 0.0;
+  double fault = 0.0;
+  int end = 0;
+  double cut_m = 0.0;
+  int ring_shift = 0;
+};
+
+ViewDraws Draw(std::mt19937_64* rng) {
+  ViewDraws d;
+  d.recall = Uniform(rng, 0.0, 1.0);
+  d.fault = Uniform(rng, 0.0, 1.0);
+  d.end = Uniform(rng, 0.0, 1.0) < 0.5 ? 0 : 1;
+  d.cut_m = Uniform(rng, 0.25, 1.0);
+  d.ring_shift = sim::UniformInt(rng, 0, 3);
+  return d;
+}
+
+// Moves one end of the band `cut_m` towards the other (a stain or worn
+// paint where the reconstruction sees the end): false when that would leave
+// less than 1.5 m.
+bool CutShort(const CameraView& left, const CameraView& right, int end,
+              double cut_m, BandView* view) {
+  std::array<Eigen::Vector3d, 4>& q = view->corners;
+  const auto ends = BandEnds(q);
+  const Eigen::Vector3d end0 = 0.5 * (q[ends[0][0]] + q[ends[0][1]]);
+  const Eigen::Vector3d end1 = 0.5 * (q[ends[1][0]] + q[ends[1][1]]);
+  if ((end0 - end1).norm() - cut_m < 1.5) return false;
+  const Eigen::Vector3d along = (end1 - end0).normalized();
+  const double sign = end == 0 ? 1.0 : -1.0;
+  for (int k : ends[end]) {
+    q[k] += sign * cut_m * along;
+    left.camera->Project(left.T_cam_enu * q[k], &view->uv_left[k]);
+    right.camera->Project(right.T_cam_enu * q[k], &view->uv_right[k]);
+  }
+  return true;
+}
+
+// Appends the band's four vertices: body frame of the true pose plus noise
+// mostly along the left camera's viewing ray (part shared by the band),
+// pixels plus noise; an inferred end (-1: none) adds its sd along the band.
+void AppendVertices(const ReconstructionModel& model, const BandView& view,
+                    const CameraView& left, const Eigen::Isometry3d& T_body_enu,
+                    int inferred_end, int ring_shift, ReconstructedVertex base,
+                    std::mt19937_64* rng,
+                    std::vector<ReconstructedVertex>* vertices) {
+  const std::array<Eigen::Vector3d, 4>& q = view.corners;
+  const auto ends = BandEnds(q);
+  const Eigen::Vector3d along =
+      (Centre(q) - 0.5 * (q[ends[0][0]] + q[ends[0][1]])).normalized();
+  const double sigma_ray =
+      model.ray_sigma_at_5m_m *
+      std::pow(std::max(view.range_m, 1.0) / 5.0, model.range_exponent);
+  const double sigma_across =
+      std::max(model.min_sigma_m, model.perpendicular_share * sigma_ray);
+  const double own = std::sqrt(1.0 - model.shared_share);
+  const double shared = std::sqrt(model.shared_share);
+  const Eigen::Vector3d ray = (Centre(q) - left.centre_enu).normalized();
+  const Eigen::Vector3d side = ray.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d up = side.cross(ray);
+  auto draw = [&](double share) {
+    return Eigen::Vector3d(Gaussian(rng, share * sigma_ray) * ray +
+                           Gaussian(rng, share * sigma_across) * side +
+                           Gaussian(rng, share * sigma_across) * up);
+  };
+  const Eigen::Vector3d common = draw(shared);
+  const Eigen::Matrix3d cov_enu =
+      sigma_ray * sigma_ray * ray * ray.transpose() +
+      sigma_across * sigma_across *
+          (Eigen::Matrix3d::Identity() - ray * ray.transpose());
+  const Eigen::Matrix3d R_body_enu = T_body_enu.linear();
+  const double px = model.pixel_sigma_px;
+  for (int label = 0; label < 4; ++label) {
+    const int k = (label + ring_shift) % 4;
+    const bool inferred_corner =
+        inferred_end >= 0 &&
+        (k == ends[inferred_end][0] || k == ends[inferred_end][1]);
+    Eigen::Vector3d noise = common + draw(own);
+    Eigen::Matrix3d cov = cov_enu;
+    if (inferred_corner) {
+      noise += Gaussian(rng, model.inferred_sigma_m) * along;
+      cov += model.inferred_sigma_m * model.inferred_sigma_m * along *
+             along.transpose();
+    }
+    ReconstructedVertex v = base;
+    v.vertex = label;
+    v.p_body = T_body_enu * (q[k] + noise);
+    v.covariance_body = R_body_enu * cov * R_body_enu.transpose();
+    v.uv_left =
+        view.uv_left[k] + Eigen::Vector2d(Gaussian(rng, px), Gaussian(rng, px));
+    v.uv_right = view.uv_right[k] +
+                 Eigen::Vector2d(Gaussian(rng, px), Gaussian(rng, px));
+    v.score = inferred_end >= 0 ? 0.9 * model.inferred_score_factor : 0.9;
+    vertices->push_back(v);
+  }
+}
+
+}  // namespace
+
 SyntheticReconstruction SynthesiseReconstruction(
     const sim::SimulatedSurvey& survey, const ReconstructionModel& model,
     uint64_t seed) {
@@ -242,126 +371,48 @@ SyntheticReconstruction SynthesiseReconstruction(
       const CameraView right = ViewOf(rig, rig.stereo_pairs[pair][1], pose);
       std::map<int, int64_t> group_of_crossing;
       for (int b = 0; b < static_cast<int>(world.bands.size()); ++b) {
-        const Band& band = world.bands[b];
-        std::array<Eigen::Vector3d, 4> q = band.corners;
-        const double range = (Centre(q) - left.centre_enu).norm();
-        if (range > model.max_range_m) continue;
-        std::array<Eigen::Vector2d, 4> uv_left, uv_right;
-        bool in_view = true;
-        for (int k = 0; k < 4 && in_view; ++k) {
-          in_view = ProjectInside(left, q[k], model.min_depth_m,
-                                  model.margin_px, &uv_left[k]) &&
-                    ProjectInside(right, q[k], model.min_depth_m,
-                                  model.margin_px, &uv_right[k]);
-        }
-        if (!in_view) continue;
+        const sim::Band& band = world.bands[b];
+        BandView view;
+        view.band = b;
+        if (!SeeWhole(model, band, left, right, &view)) continue;
         ++out.views_in_range;
-        // Draw everything for this view up front, so one decision does not
-        // shift the random stream of the others.
-        const double recall_draw = Uniform(&rng, 0.0, 1.0);
-        const double fault_draw = Uniform(&rng, 0.0, 1.0);
-        const int random_end = Uniform(&rng, 0.0, 1.0) < 0.5 ? 0 : 1;
-        const double cut_m = Uniform(&rng, 0.25, 1.0);
-        const int ring_shift = sim::UniformInt(&rng, 0, 3);
+        const ViewDraws draws = Draw(&rng);
         int hidden_end = -1;
-        const int occlusion = Occlusion(world, q, left, right, &hidden_end);
+        const int occlusion =
+            Occlusion(world, view.corners, left, right, &hidden_end);
         if (occlusion != 0) ++out.views_hidden;
-        if (occlusion == 2) continue;
-        if (recall_draw >= Recall(model, range)) continue;
-        const int crossing_bands =
-            world.crossings[band.crossing].num_street_bands;
+        if (occlusion == 2 || draws.recall >= Recall(model, view.range_m)) {
+          continue;
+        }
         bool inferred = occlusion == 1;
         bool cut_short = false;
-        if (!inferred && fault_draw < model.hidden_end_probability) {
+        if (!inferred && draws.fault < model.hidden_end_probability) {
           inferred = true;
-          hidden_end = random_end;
-        } else if (!inferred && fault_draw < model.hidden_end_probability +
-                                                 model.cut_short_probability) {
-          cut_short = true;
+          hidden_end = draws.end;
+        } else if (!inferred && draws.fault < model.hidden_end_probability +
+                                                  model.cut_short_probability) {
+          cut_short = CutShort(left, right, draws.end, draws.cut_m, &view);
         }
         // The real stage infers an end from the crossing's other bands, and
         // not far away.
-        if (inferred &&
-            (crossing_bands < 4 || range > model.max_inferred_range_m)) {
+        if (inferred && (world.crossings[band.crossing].num_street_bands < 4 ||
+                         view.range_m > model.max_inferred_range_m)) {
           continue;
-        }
-        const auto ends = BandEnds(q);
-        const Eigen::Vector3d along =
-            (Centre(q) - 0.5 * (q[ends[0][0]] + q[ends[0][1]])).normalized();
-        if (cut_short) {
-          const double length = (0.5 * (q[ends[0][0]] + q[ends[0][1]]) -
-                                 0.5 * (q[ends[1][0]] + q[ends[1][1]]))
-                                    .norm();
-          if (length - cut_m < 1.5) {
-            cut_short = false;
-          } else {
-            // The end moves towards the other one: inside the paint.
-            const double sign = random_end == 0 ? 1.0 : -1.0;
-            for (int k : ends[random_end]) q[k] += sign * cut_m * along;
-            for (int k : ends[random_end]) {
-              left.camera->Project(left.T_cam_enu * q[k], &uv_left[k]);
-              right.camera->Project(right.T_cam_enu * q[k], &uv_right[k]);
-            }
-          }
         }
         ++out.views_reconstructed;
         auto [group_it, added] =
             group_of_crossing.emplace(band.crossing, next_group_id);
         if (added) ++next_group_id;
-        const int64_t band_id = next_band_id++;
-        out.truth_of_band[band_id] = {b, range, cut_short, inferred};
-        // Noise: mostly along the ray, partly shared by the band's vertices.
-        const double sigma_ray =
-            model.ray_sigma_at_5m_m *
-            std::pow(std::max(range, 1.0) / 5.0, model.range_exponent);
-        const double sigma_across =
-            std::max(model.min_sigma_m, model.perpendicular_share * sigma_ray);
-        const double own = std::sqrt(1.0 - model.shared_share);
-        const double shared = std::sqrt(model.shared_share);
-        const Eigen::Vector3d ray = (Centre(q) - left.centre_enu).normalized();
-        const Eigen::Vector3d side =
-            ray.cross(Eigen::Vector3d::UnitZ()).normalized();
-        const Eigen::Vector3d up = side.cross(ray);
-        auto draw = [&](double s) {
-          return Eigen::Vector3d(Gaussian(&rng, s * sigma_ray) * ray +
-                                 Gaussian(&rng, s * sigma_across) * side +
-                                 Gaussian(&rng, s * sigma_across) * up);
-        };
-        const Eigen::Vector3d common = draw(shared);
-        const Eigen::Matrix3d cov_enu =
-            sigma_ray * sigma_ray * ray * ray.transpose() +
-            sigma_across * sigma_across *
-                (Eigen::Matrix3d::Identity() - ray * ray.transpose());
-        const Eigen::Matrix3d R_body_enu = T_body_enu.linear();
-        for (int label = 0; label < 4; ++label) {
-          const int k = (label + ring_shift) % 4;
-          const bool inferred_corner = inferred && (k == ends[hidden_end][0] ||
-                                                    k == ends[hidden_end][1]);
-          Eigen::Vector3d noise = common + draw(own);
-          Eigen::Matrix3d cov = cov_enu;
-          double score = 0.9;
-          if (inferred_corner) {
-            noise += Gaussian(&rng, model.inferred_sigma_m) * along;
-            cov += model.inferred_sigma_m * model.inferred_sigma_m * along *
-                   along.transpose();
-            score *= model.inferred_score_factor;
-          }
-          ReconstructedVertex v;
-          v.exposure_id = exposure.exposure_id;
-          v.pair = pair;
-          v.band_id = band_id;
-          v.group_id = group_it->second;
-          v.vertex = label;
-          v.p_body = T_body_enu * (q[k] + noise);
-          v.covariance_body = R_body_enu * cov * R_body_enu.transpose();
-          const double px = model.pixel_sigma_px;
-          v.uv_left = uv_left[k] +
-                      Eigen::Vector2d(Gaussian(&rng, px), Gaussian(&rng, px));
-          v.uv_right = uv_right[k] +
-                       Eigen::Vector2d(Gaussian(&rng, px), Gaussian(&rng, px));
-          v.score = inferred ? 0.9 * model.inferred_score_factor : score;
-          out.vertices.push_back(v);
-        }
+        ReconstructedVertex base;
+        base.exposure_id = exposure.exposure_id;
+        base.pair = pair;
+        base.band_id = next_band_id++;
+        base.group_id = group_it->second;
+        out.truth_of_band[base.band_id] = {b, view.range_m, cut_short,
+                                           inferred};
+        AppendVertices(model, view, left, T_body_enu,
+                       inferred ? hidden_end : -1, draws.ring_shift, base, &rng,
+                       &out.vertices);
       }
     }
   }
