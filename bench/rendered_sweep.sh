@@ -13,8 +13,8 @@
 #   BUILD_DIR  default: build
 # Environment: WORK (default /tmp/zebrageo-rendered-sweep) holds the surveys
 # (kept: a rerun renders only what is missing) and the results (redone);
-# MAX_ROAD_LENGTH (default 250 m) keeps the streets short: 30 surveys
-# render and run in about 30-40 minutes on 2 idle cores; ZEBRAGEO_THREADS
+# MAX_ROAD_LENGTH (default 300 m) keeps the streets short: 30 surveys
+# render and run in about 30-60 minutes on 2 idle cores; ZEBRAGEO_THREADS
 # (default 2).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -27,7 +27,7 @@ zebrageo="$build/tools/zebrageo"
   echo "no ../shared/tools/score_results.py beside the repository"; exit 1; }
 work="${WORK:-/tmp/zebrageo-rendered-sweep}"
 first="${FIRST_SEED:-1}"
-max_length="${MAX_ROAD_LENGTH:-250}"
+max_length="${MAX_ROAD_LENGTH:-300}"
 threads="${ZEBRAGEO_THREADS:-2}"
 mkdir -p "$work"
 scores="$work/scores.jsonl"

@@ -86,16 +86,20 @@ void DrawStreet(std::mt19937_64* rng, const RandomPresetLimits& limits,
   o->stop_line_probability = Uniform(rng, 0.0, 0.6);
   o->parked_vehicles_per_100m = Uniform(rng, 0.0, 6.0);
   o->occluding_vehicle_probability = Uniform(rng, 0.0, 0.5);
-  // Crossings: a short street has 2; a longer one one every 50-250 m.
+  // Crossings: a short street has 2; a longer one one every 35-100 m up to
+  // 400 m (city blocks), every 50-250 m beyond.
   const double longest_crossing =
       o->max_band_length_m + o->road_width_m * std::tan(30.0 * kPi / 180.0);
   const double min_spacing = longest_crossing + 6.0;
   int crossings =
       short_street
           ? 2
-          : std::clamp(static_cast<int>(std::lround(o->road_length_m /
-                                                    Uniform(rng, 50.0, 250.0))),
-                       2, 14);
+          : std::clamp(
+                static_cast<int>(std::lround(
+                    o->road_length_m / (o->road_length_m < 400.0
+                                            ? Uniform(rng, 35.0, 100.0)
+                                            : Uniform(rng, 50.0, 250.0)))),
+                2, 14);
   o->num_stale_crossings = 0;
   // The road holds positions * spacing + 22 m (Check()).
   const int most = static_cast<int>((o->road_length_m - 22.0) / min_spacing);
