@@ -218,15 +218,15 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
   }
 
   motion.multipath_switches = DrawMultipathSwitches(options, world);
-  // Sample-rate jitter: AR(1) per horizontal axis, its step sized for the
-  // direction of travel (speed * dt per sample) to depart from the heading
-  // by jitter_direction_deg RMS.
+  // Sample-rate jitter: AR(1) per axis, its step sized for the direction of
+  // travel (speed * dt per sample) to depart from the heading by
+  // jitter_direction_deg RMS.
   std::mt19937_64 jitter_rng(SubSeed(options.seed, kJitterSeed));
   const double jitter_step_m =
       options.vehicle_speed_mps * dt *
       std::tan(options.jitter_direction_deg * kDegToRad);
   const double jitter_decay = std::exp(-dt / options.jitter_correlation_s);
-  Eigen::Vector2d jitter = Eigen::Vector2d::Zero();
+  Eigen::Vector3d jitter = Eigen::Vector3d::Zero();
 
   motion.truth.reserve(n);
   motion.measured.reserve(n);
@@ -268,9 +268,10 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
     }
     if (jitter_step_m > 0.0) {
       jitter = jitter_decay * jitter +
-               Eigen::Vector2d(Gaussian(&jitter_rng, jitter_step_m),
+               Eigen::Vector3d(Gaussian(&jitter_rng, jitter_step_m),
+                               Gaussian(&jitter_rng, jitter_step_m),
                                Gaussian(&jitter_rng, jitter_step_m));
-      error.head<2>() += jitter;
+      error += jitter;
     }
     double outage_fraction = 0.0;
     double extra_heading = 0.0;

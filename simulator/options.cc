@@ -389,7 +389,7 @@ std::string SimulationOptions::Check() const {
   c.Range("multipath_jump_m", multipath_jump_m, 0.0, 20.0);
   c.Range("multipath_switch_length_m", multipath_switch_length_m, 1.0, 1000.0);
   c.Range("jitter_direction_deg", jitter_direction_deg, 0.0, 30.0);
-  c.Range("jitter_correlation_s", jitter_correlation_s, 0.1, 1000.0);
+  c.Range("jitter_correlation_s", jitter_correlation_s, 0.01, 1000.0);
   c.Range("reported_sd_horizontal_m", reported_sd_horizontal_m, 0.0, 100.0);
   c.Range("reported_sd_vertical_m", reported_sd_vertical_m, 0.0, 100.0);
   c.Range("reported_sd_tilt_deg", reported_sd_tilt_deg, 0.0, 10.0);

@@ -173,7 +173,7 @@ void DrawTrajectoryError(std::mt19937_64* rng, const std::string& kind,
       kind == "jitter" || (kind == "mixed" && Bernoulli(rng, 0.3));
   if (jitter) {
     o->jitter_direction_deg = Uniform(rng, 2.0, 8.0);
-    o->jitter_correlation_s = Uniform(rng, 1.0, 5.0);
+    o->jitter_correlation_s = Uniform(rng, 0.1, 1.0);
   }
   // What the solution claims: optimistic, or honest about its drift.
   if (Bernoulli(rng, 0.5)) {

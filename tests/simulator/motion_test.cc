@@ -220,12 +220,15 @@ TEST(Motion, JitterTurnsTheDirectionOfTravelAwayFromTheHeading) {
   const double rms_deg = std::sqrt(sum_sq / count) / kDeg;
   EXPECT_GT(rms_deg, 4.0);
   EXPECT_LT(rms_deg, 9.0);
-  // Mean-reverting: the position error stays bounded (decimetres).
+  // Mean-reverting within jitter_correlation_s (0.25 s): at 10 m/s and
+  // 100 Hz its stationary sd is about 3 cm, as amiens-short-jittery's.
   double max_h = 0.0;
   for (const Eigen::Vector3d& e : motion.position_error_enu) {
     max_h = std::max(max_h, e.head<2>().norm());
   }
-  EXPECT_LT(max_h, options.drift_along_track_m + 1.0);
+  EXPECT_LT(max_h, std::hypot(options.drift_along_track_m,
+                              options.drift_cross_track_m) +
+                       0.2);
 }
 
 }  // namespace
