@@ -24,6 +24,8 @@ TEST(GeometrySweep, FiveHundredRandomSurveysMeetIssue17) {
   options.max_road_length_m = 400.0;
   const int threads = static_cast<int>(
       std::max(1u, std::min(2u, std::thread::hardware_concurrency())));
+  std::cout << "Failing surveys (reproduce one with build/bench/geometry_sweep "
+               "--max-length 400 --verbose SEED -o DIR):\n";
   const std::vector<GeometryRunResult> results = RunGeometrySweep(
       1, 500, threads, options, [](const GeometryRunResult& r) {
         // The failing surveys, to reproduce with bench/geometry_sweep.
