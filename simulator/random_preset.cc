@@ -7,11 +7,11 @@
 
 #include "simulator/noise.h"
 #include "simulator/simulator.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Purpose of the preset's generator (sim::SubSeed); the world's own
 // generators use small numbers.
 constexpr uint64_t kRandomPresetSeed = 401;

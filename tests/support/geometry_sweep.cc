@@ -19,12 +19,12 @@
 #include "registration/match_stage.h"
 #include "registration/roadmark_index.h"
 #include "simulator/simulated_survey.h"
+#include "survey/math_util.h"
 #include "tests/support/synthetic_reconstruction.h"
 
 namespace zebrageo::support {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 // score_results.py: a matched vertex farther than this from its truth
 // corner is wrong.
 constexpr double kRightVertexM = 0.2;
@@ -38,13 +38,6 @@ std::map<CornerKey, std::array<Eigen::Vector3d, 4>> TruthCorners(
     corners[{world.crossings[band.crossing].id, band.band}] = band.corners;
   }
   return corners;
-}
-
-double Rms(const std::vector<double>& values) {
-  if (values.empty()) return 0.0;
-  double sum = 0.0;
-  for (double v : values) sum += v * v;
-  return std::sqrt(sum / values.size());
 }
 
 // Scores the matches as score_results.py match does.
@@ -111,7 +104,7 @@ struct PoseErrors {
     v.push_back(std::abs(d.z()));
     const double c = std::clamp(
         0.5 * ((R.transpose() * T_true.linear()).trace() - 1.0), -1.0, 1.0);
-    att.push_back(std::acos(c) * kRadToDeg);
+    att.push_back(RadToDeg(std::acos(c)));
   }
 };
 
@@ -184,15 +177,11 @@ std::string Fixed(double value, int digits) {
   return out.str();
 }
 
-// Median, 95th percentile (nearest rank) and worst.
-std::array<double, 3> Spread(std::vector<double> values) {
+// Median, 95th percentile and worst.
+std::array<double, 3> Spread(const std::vector<double>& values) {
   if (values.empty()) return {0.0, 0.0, 0.0};
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  const double median =
-      n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-  const size_t rank = static_cast<size_t>(std::ceil(0.95 * n));
-  return {median, values[std::max<size_t>(rank, 1) - 1], values.back()};
+  return {Median(values), Percentile(values, 0.95),
+          *std::max_element(values.begin(), values.end())};
 }
 
 std::string SpreadText(const std::array<double, 3>& s, int digits) {
