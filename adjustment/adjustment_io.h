@@ -67,6 +67,17 @@ void WriteAdjustmentResults(const AdjustmentData& data,
                             const TiePointSummary* tie_summary,
                             const std::string& results_folder);
 
+// matches.csv holds the vertices that became control points
+// (SURVEY_FORMAT.md): the ones the adjustment rejected (a crossing
+// inconsistent with the others, matched one band off; a blunder) are
+// removed from it, and an observation left without any is refused in
+// crossing_decisions.csv, with the reason. Both rewritten atomically, only
+// when something was rejected. Returns the number of vertex matches
+// removed.
+int RemoveRejectedMatches(const AdjustmentData& data,
+                          const AdjustmentResult& result,
+                          const std::string& results_folder);
+
 // Writes the gcp_residuals.csv rows of `points` to `path`.
 void WriteGcpResidualsWithStatus(const std::vector<ControlPointResult>& points,
                                  const std::string& path);

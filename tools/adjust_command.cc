@@ -87,6 +87,12 @@ std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
   RemoveStaleTemporaries(results_folder);
   WriteAdjustmentResults(data, options, result,
                          use_ties ? &tie_summary : nullptr, results_folder);
+  const int removed = RemoveRejectedMatches(data, result, results_folder);
+  if (removed > 0) {
+    LOG(INFO) << "adjust: " << removed
+              << " vertex matches rejected by the adjustment removed from "
+              << kMatchesFile;
+  }
   LOG(INFO) << "adjust: " << result.summary.BriefReport();
   return warnings;
 }
