@@ -8,6 +8,7 @@
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
@@ -126,14 +127,14 @@ nlohmann::json SummaryJson(const AdjustmentData& data,
   j["rig"] = rig;
   j["model"] = {
       {"knot_spacing_s", options.knot_spacing_s},
-      {"gnss_sigma_horizontal_m", s.gnss_sigma_horizontal_m},
-      {"gnss_sigma_vertical_m", s.gnss_sigma_vertical_m},
-      {"gnss_sigma_estimated", options.estimate_gnss_sigma},
-      {"prior_correlation_time_s", options.prior_correlation_time_s},
-      {"ins_tilt_sigma_deg", options.ins_tilt_sigma_deg},
-      {"ins_heading_sigma_deg", options.ins_heading_sigma_deg},
-      {"drift_rate_sigma_mps", options.drift_rate_sigma_mps},
-      {"drift_acceleration_sigma_mps2", options.drift_acceleration_sigma_mps2},
+      {"position_model_estimated", options.estimate_position_model},
+      // Along-track, cross-track, up.
+      {"position_sigma_m", Vector3Json(s.position_sigma_m)},
+      {"position_tau_s", Vector3Json(s.position_tau_s)},
+      {"attitude_sigma_deg", Vector3Json(RadToDeg(1.0) * s.attitude_sigma_rad)},
+      {"vehicle_motion_sigma_deg",
+       {RadToDeg(s.motion_sigma_rad.x()), RadToDeg(s.motion_sigma_rad.y())}},
+      {"tie_sigma_px", s.tie_sigma_px},
       {"vertex_sigma_px", options.vertex_sigma_px},
       {"crossing_offset_sigma_m", options.crossing_offset_sigma_m},
       {"check_crossing_share", options.check_crossing_share},

@@ -79,6 +79,17 @@ std::vector<VehicleMotionSample> MakeVehicleMotionSamples(
     double min_half_chord_s, double min_speed_mps,
     const Eigen::Vector2d& sigma_rad, PoseAt&& ins_pose_at);
 
+// The high-frequency spread (lateral, vertical; radians) of the crab
+// angles of `samples` under `correction` (zero vehicle block): each angle
+// minus the median of those within +-window_s, robust RMS of that. A
+// trajectory whose positions jitter from sample to sample (an unsmoothed
+// GNSS solution) has a direction of travel that departs from its heading
+// by degrees over a short chord; no smooth correction removes that, so it
+// is the constraint's noise, not the vehicle's sideslip.
+Eigen::Vector2d HighFrequencyCrabSpread(
+    const std::vector<VehicleMotionSample>& samples,
+    const TrajectoryCorrection& correction, double window_s);
+
 // The residual as a function of the corrections c at t - h, t, t + h (6
 // each) and the vehicle block.
 class VehicleMotionError {
