@@ -304,10 +304,11 @@ AdjustmentInput AdjustmentData::Input() const {
 }
 
 AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
-                                  const std::string& results_folder) {
+                                  const std::string& results_folder,
+                                  const SurveyPathOptions& paths) {
   AdjustmentData data;
   data.survey_folder = survey_folder;
-  data.manifest = ReadManifest(survey_folder);
+  data.manifest = ReadManifest(survey_folder, paths);
   auto path_of = [&](const std::string& name) {
     return (fs::path(survey_folder) / name).string();
   };

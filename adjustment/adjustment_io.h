@@ -52,11 +52,13 @@ struct AdjustmentData {
   AdjustmentInput Input() const;
 };
 
-// Throws InputError: any survey file the readers reject, exposures outside
+// Throws InputError: any survey file the readers reject (survey.yaml's
+// files confined to the survey folder as `paths` says), exposures outside
 // the trajectory, a missing or malformed reconstructed_bands.csv or
 // matches.csv (the message says which stage to run first).
 AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
-                                  const std::string& results_folder);
+                                  const std::string& results_folder,
+                                  const SurveyPathOptions& paths = {});
 
 // Writes every output listed above into `results_folder` (created if
 // needed). `tie_summary` may be null (no tie points). Throws
