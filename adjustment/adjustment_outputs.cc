@@ -255,8 +255,9 @@ void FillControlPoints(const OutputContext& context, State* state,
     for (const std::string& name : names)
       list += (list.empty() ? "" : ", ") + name;
     context.warn(std::to_string(summary.num_rejected_points) +
-                 " control vertices rejected as blunders (crossings " + list +
-                 ")");
+                 " control vertices rejected (crossings " + list +
+                 "): inconsistent with the other crossings, or blunders; not "
+                 "used as control, removed from matches.csv");
   }
 }
 

@@ -39,10 +39,17 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
     }
     return m;
   };
-  // Departure of each step from its neighbours' motion.
+  // Departure of each step from its neighbours' motion. A step across a
+  // gap of the trajectory (survey/trajectory.h) is not one: the vehicle's
+  // motion during the gap is unknown, so it is never taken for a jump.
+  std::vector<bool> across_gap(n, false);
+  for (const TrajectoryGap& gap : FindTrajectoryGaps(SampleTimes(samples))) {
+    across_gap[gap.before + 1] = true;
+  }
   std::vector<Eigen::Vector3d> position_step(n, Eigen::Vector3d::Zero());
   std::vector<Eigen::Vector3d> rotation_step(n, Eigen::Vector3d::Zero());
   for (int i = 1; i < n; ++i) {
+    if (across_gap[i]) continue;
     const double dt = samples[i].time - samples[i - 1].time;
     position_step[i] = (velocity[i] - median_of_neighbours(velocity, i)) * dt;
     rotation_step[i] = (rate[i] - median_of_neighbours(rate, i)) * dt;

@@ -223,12 +223,15 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   nlohmann::json rejected_json = nlohmann::json::array();
   for (const RejectedLine& r : rejected) {
     const DatabaseLineEnu& line = database[r.db_line];
+    // The report's wording (tools/report/report.cc), so the warning is
+    // listed once in report.json.
     std::ostringstream w;
-    w << "road-mark database line " << line.id << " (" << line.type << ") lies "
+    w << "database: road line " << line.id << " (" << line.type << ") lies "
       << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
-      << " m across from where the other lines seen with it put it ("
-      << r.points << " points): repainted or stale, not used as control";
+      << " m across from where the other lines put it: repainted or stale, "
+         "not used as control";
     LOG(WARNING) << w.str();
+    warnings->push_back(w.str());
     rejected_json.push_back({{"db_line", line.id},
                              {"type", line.type},
                              {"points", r.points},
