@@ -180,6 +180,31 @@ class Visibility {
   bool enabled() const { return rig_ != nullptr && range_m_ > 0.0; }
   double range_m() const { return range_m_; }
 
+  // Whether the image probe may look for `band` from `pose`: its centre
+  // in front of the left camera of the first stereo pair (the probe's),
+  // inside that image, within probe_range_m. The probe itself then says
+  // whether enough of the band is in the image to tell paint from asphalt
+  // (PaintProbeOptions::min_inside_share): bare road seen where a band is
+  // predicted is evidence whether or not the reconstruction could have
+  // delivered that band whole.
+  bool ProbeMayLook(const Pose& pose, const IndexedBand& band,
+                    double probe_range_m) const {
+    if (rig_ == nullptr || rig_->stereo_pairs.empty()) return false;
+    if ((band.centre_enu - pose.p_enu.head<2>()).norm() > probe_range_m) {
+      return false;
+    }
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& c : band.corners_enu) centre += 0.25 * c;
+    const int cam = rig_->stereo_pairs.front()[0];
+    const Eigen::Vector3d p_cam =
+        T_cam_body_[cam] *
+        (pose.q_enu_body.conjugate() * (centre - pose.p_enu));
+    Eigen::Vector2d uv;
+    const Camera& camera = rig_->cameras[cam].camera;
+    return p_cam.z() > 1.0 && camera.Project(p_cam, &uv) &&
+           camera.IsInImage(uv);
+  }
+
   bool BandVisible(const Pose& pose, const IndexedBand& band) const {
     if (!enabled()) return false;
     if ((band.centre_enu - pose.p_enu.head<2>()).norm() > range_m_) {
@@ -267,6 +292,15 @@ class Matcher {
   // Stage 4.
   std::vector<Pass> BuildPasses() const;
   static double PassGap(const Pass& a, const Pass& b);
+  // The matches of accepted observation `o` after refining its correction
+  // on its own bands: the bands whose every corner fits to
+  // vertex_tolerance_m.
+  std::vector<VertexMatch> RefinedMatches(int o, PoseCorrection* correction,
+                                          std::vector<int>* bands,
+                                          double* rms_m) const;
+  // Refuses `o` when fewer than min_hit_bands bands fit after refinement
+  // (a hypothesis that fits only loosely); true when refused.
+  bool RefuseUnrefined(int o);
   void CheckContinuity();
   void ResolveFromNeighbours();
   void DetectShiftedCrossings();
@@ -573,7 +607,12 @@ Eval Matcher::Evaluate(const Obs& obs, const PoseCorrection& c) const {
       predicted.insert(predicted.end(), implied.begin(), implied.end());
       for (int b : predicted) {
         if (used_db.count(b)) continue;
-        if (!visibility_.BandVisible(pose, index_.bands()[b])) continue;
+        const bool may_look =
+            input_.paint_probe
+                ? visibility_.ProbeMayLook(pose, index_.bands()[b],
+                                           options_.probe_range_m)
+                : visibility_.BandVisible(pose, index_.bands()[b]);
+        if (!may_look) continue;
         // A band the reconstruction missed (hidden, worn, lost at range) is
         // no evidence; bare road where the hypothesis puts paint is.
         if (input_.paint_probe &&
@@ -1390,15 +1429,18 @@ void Matcher::ResolveFromNeighbours() {
   }
 }
 
-void Matcher::EmitMatches(int o) {
+std::vector<VertexMatch> Matcher::RefinedMatches(int o,
+                                                 PoseCorrection* correction,
+                                                 std::vector<int>* bands,
+                                                 double* rms_m) const {
   const Obs& obs = obs_[o];
   const Hypothesis& h = hypotheses_[o][chosen_[o]];
   // Refine on this observation's own bands, then keep the bands whose every
   // corner fits.
   const PoseCorrection c = Refine(obs, h.eval, h.correction);
   const Eval eval = Evaluate(obs, c);
-  ObservationEvidence& ev = evidence_[o];
-  ev.correction = c;
+  *correction = c;
+  bands->clear();
   double sum = 0.0;
   int count = 0;
   std::vector<VertexMatch> out;
@@ -1415,7 +1457,7 @@ void Matcher::EmitMatches(int o) {
       fits = fits && error[k] <= options_.vertex_tolerance_m;
     }
     if (!fits) continue;
-    ev.matched_bands.push_back(db.band);
+    bands->push_back(db.band);
     const ObservedBand& source = obs.source->bands[hit.rec];
     for (int k = 0; k < 4; ++k) {
       VertexMatch match;
@@ -1430,18 +1472,31 @@ void Matcher::EmitMatches(int o) {
       ++count;
     }
   }
-  if (static_cast<int>(ev.matched_bands.size()) < options_.min_hit_bands) {
-    accepted_[o] = false;
-    ev.decision = Decision::kRefused;
-    ev.reason = "after refinement only " +
-                std::to_string(ev.matched_bands.size()) +
-                " band(s) fit to vertex_tolerance_m = " +
-                Fixed(options_.vertex_tolerance_m, 2) + " m; was: " + ev.reason;
-    ev.matched_bands.clear();
-    return;
-  }
-  ev.vertex_matches = count;
-  ev.vertex_rms_m = count > 0 ? std::sqrt(sum / count) : 0.0;
+  *rms_m = count > 0 ? std::sqrt(sum / count) : 0.0;
+  return out;
+}
+
+bool Matcher::RefuseUnrefined(int o) {
+  PoseCorrection c;
+  std::vector<int> bands;
+  double rms = 0.0;
+  RefinedMatches(o, &c, &bands, &rms);
+  if (static_cast<int>(bands.size()) >= options_.min_hit_bands) return false;
+  ObservationEvidence& ev = evidence_[o];
+  accepted_[o] = false;
+  ev.decision = Decision::kRefused;
+  ev.reason = "after refinement only " + std::to_string(bands.size()) +
+              " band(s) fit to vertex_tolerance_m = " +
+              Fixed(options_.vertex_tolerance_m, 2) + " m; was: " + ev.reason;
+  return true;
+}
+
+void Matcher::EmitMatches(int o) {
+  ObservationEvidence& ev = evidence_[o];
+  if (RefuseUnrefined(o)) return;
+  const std::vector<VertexMatch> out =
+      RefinedMatches(o, &ev.correction, &ev.matched_bands, &ev.vertex_rms_m);
+  ev.vertex_matches = static_cast<int>(out.size());
   matches_.insert(matches_.end(), out.begin(), out.end());
 }
 
@@ -1664,6 +1719,11 @@ MatchResult Matcher::Run(const std::function<void(int, int)>& progress) {
   window_.assign(n, {0, 0});
   Aggregate();
   for (int o = 0; o < n; ++o) DecideAlone(o);
+  // Only observations whose match survives refinement may vouch for their
+  // neighbours.
+  for (int o = 0; o < n; ++o) {
+    if (accepted_[o]) RefuseUnrefined(o);
+  }
   CheckContinuity();
   ResolveFromNeighbours();
   DetectShiftedCrossings();
@@ -1789,6 +1849,7 @@ std::string MatchOptions::Check() const {
       !non_negative("drift_rate_m_per_s", drift_rate_m_per_s) ||
       !positive("min_margin", min_margin) ||
       !non_negative("min_strong_margin", min_strong_margin) ||
+      !positive("probe_range_m", probe_range_m) ||
       !non_negative("neighbour_window_s", neighbour_window_s) ||
       !positive("neighbour_tolerance_m", neighbour_tolerance_m) ||
       !non_negative("max_drift_rate_m_per_s", max_drift_rate_m_per_s) ||

@@ -117,6 +117,10 @@ struct MatchOptions {
   // ... and its centre lies within this horizontal range of the vehicle.
   // 0: take the 90th percentile of the observed bands' ranges.
   double visibility_range_m = 0.0;
+  // With an image probe (MatchInput::paint_probe), a predicted band is
+  // looked for wherever its centre lies in the probe's image within this
+  // range; the probe decides whether enough of it is in view.
+  double probe_range_m = 20.0;
 
   // --- Aggregation over time --------------------------------------------
   // Observations within +-window_s of each other share one correction.
