@@ -205,8 +205,82 @@ std::string LongSideOptions::Check() const {
   } else if (!(min_long_side_length_m > 0.0)) {
     error << "min_long_side_length_m = " << min_long_side_length_m
           << ": must be > 0";
+  } else if (height_smoothing_half_window < 0) {
+    error << "height_smoothing_half_window = " << height_smoothing_half_window
+          << ": must be >= 0";
   }
   return error.str();
+}
+
+void RegulariseChainHeights(const RoadPlane& road,
+                            const Eigen::Vector3d& left_centre_body,
+                            int half_window, EdgeChain3d* chain) {
+  std::vector<EdgePoint3d>& points = chain->points;
+  const int n = static_cast<int>(points.size());
+  for (EdgePoint3d& p : points) p.p_chain_body = p.p_body;
+  if (half_window <= 0 || n < 3) return;
+  std::vector<double> height(n), smooth(n);
+  for (int i = 0; i < n; ++i) height[i] = road.SignedDistance(points[i].p_body);
+  std::vector<char> use(n, 1);
+  // Two pointers over the window; sums of 1, u, u^2, h, u h of the used
+  // points (u relative to the chain's first point).
+  auto fit = [&]() {
+    const int u0 = points[0].index_in_chain;
+    double s0 = 0, su = 0, suu = 0, sh = 0, suh = 0;
+    int lo = 0, hi = 0;  // window [lo, hi)
+    for (int i = 0; i < n; ++i) {
+      const int ui = points[i].index_in_chain;
+      while (hi < n && points[hi].index_in_chain <= ui + half_window) {
+        if (use[hi]) {
+          const double u = points[hi].index_in_chain - u0;
+          s0 += 1.0;
+          su += u;
+          suu += u * u;
+          sh += height[hi];
+          suh += u * height[hi];
+        }
+        ++hi;
+      }
+      while (points[lo].index_in_chain < ui - half_window) {
+        if (use[lo]) {
+          const double u = points[lo].index_in_chain - u0;
+          s0 -= 1.0;
+          su -= u;
+          suu -= u * u;
+          sh -= height[lo];
+          suh -= u * height[lo];
+        }
+        ++lo;
+      }
+      if (s0 < 3.0) {
+        smooth[i] = height[i];
+        continue;
+      }
+      const double mean_u = su / s0;
+      const double mean_h = sh / s0;
+      const double var_u = suu / s0 - mean_u * mean_u;
+      const double cov = suh / s0 - mean_u * mean_h;
+      const double slope = var_u > 1e-6 ? cov / var_u : 0.0;
+      smooth[i] = mean_h + slope * ((ui - u0) - mean_u);
+    }
+  };
+  fit();
+  std::vector<double> residual(n);
+  for (int i = 0; i < n; ++i) residual[i] = std::abs(height[i] - smooth[i]);
+  std::vector<double> sorted = residual;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const double limit = std::max(0.005, 3.0 * 1.4826 * sorted[n / 2]);
+  for (int i = 0; i < n; ++i) use[i] = residual[i] <= limit;
+  fit();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d ray = points[i].p_body - left_centre_body;
+    const double denominator = road.normal_body.dot(ray);
+    if (!(std::abs(denominator) > 1e-9)) continue;
+    const double t =
+        (smooth[i] + road.offset_m - road.normal_body.dot(left_centre_body)) /
+        denominator;
+    if (t > 0.0) points[i].p_chain_body = left_centre_body + t * ray;
+  }
 }
 
 PlaneFrame PlaneFrame::Make(const RoadPlane& plane,
@@ -407,7 +481,7 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
     const int first_index = static_cast<int>(result.points.size());
     for (const EdgePoint3d& p : chain.points) {
       result.points.push_back(p);
-      result.points_2d.push_back(frame.To2d(p.p_body));
+      result.points_2d.push_back(frame.To2d(p.p_chain_body));
     }
     const int n = static_cast<int>(chain.points.size());
     int start = 0;
@@ -507,11 +581,11 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
         side.direction_set = set;
         side.direction_2d = direction;
         Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (int i : g.support) mean += result.points[i].p_body;
+        for (int i : g.support) mean += result.points[i].p_chain_body;
         mean /= static_cast<double>(g.support.size());
         Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
         for (int i : g.support) {
-          const Eigen::Vector3d d = result.points[i].p_body - mean;
+          const Eigen::Vector3d d = result.points[i].p_chain_body - mean;
           scatter += d * d.transpose();
         }
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
@@ -524,7 +598,7 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
         const Eigen::Vector3d across = frame.normal.cross(axis).normalized();
         double lateral_ss = 0.0, height_ss = 0.0, contrast = 0.0;
         for (int i : g.support) {
-          const Eigen::Vector3d d = result.points[i].p_body - mean;
+          const Eigen::Vector3d d = result.points[i].p_chain_body - mean;
           const double t = d.dot(axis);
           side.t_begin = std::min(side.t_begin, t);
           side.t_end = std::max(side.t_end, t);
