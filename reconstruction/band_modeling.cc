@@ -9,6 +9,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "reconstruction/crossing_regularity.h"
 #include "reconstruction/road_plane.h"
 
 namespace zebrageo {
@@ -212,6 +213,29 @@ Eigen::Vector3d OnBandPlane(const PlaneFrame& frame, const RoadPlane& plane,
   return p - plane.SignedDistance(p) / denominator * frame.normal;
 }
 
+// Unit normal, in rectified image `side`, of the line of the band plane
+// through the centre of `area_3d` along `direction_2d` (plane frame),
+// oriented like `like`.
+Eigen::Vector2d ImageNormalOf(const RoadRectification& rectification, int side,
+                              const PlaneFrame& frame, const RoadPlane& plane,
+                              const std::array<Eigen::Vector3d, 4>& area_3d,
+                              const Eigen::Vector2d& direction_2d,
+                              const Eigen::Vector2d& like) {
+  const Eigen::Vector3d centre =
+      0.25 * (area_3d[0] + area_3d[1] + area_3d[2] + area_3d[3]);
+  const Eigen::Vector3d ahead =
+      OnBandPlane(frame, plane, frame.To2d(centre) + 0.5 * direction_2d);
+  Eigen::Vector2d a, b;
+  if (!rectification.ProjectToRectified(side, centre, &a) ||
+      !rectification.ProjectToRectified(side, ahead, &b)) {
+    return like;
+  }
+  const Eigen::Vector2d d = (b - a).normalized();
+  Eigen::Vector2d normal(-d.y(), d.x());
+  if (normal.dot(like) < 0.0) normal = -normal;
+  return normal;
+}
+
 // Least-squares plane of a band and the variance of its height at a point:
 // z = a x + b y + c in the band's own frame (x along, y across, z normal).
 struct BandPlaneFit {
@@ -278,6 +302,10 @@ struct KnownEnd {
   // For the seen end of such a band: the crossing's line there, to choose
   // among the candidates (what hides the other end may have edges too).
   const PlaneLine* expected = nullptr;
+  // The crossing's direction of the transversal sides (plane frame): a seen
+  // end is fitted with it (only its offset), once its own direction is
+  // found within max_end_angle_rad of it.
+  const Eigen::Vector2d* direction = nullptr;
 };
 
 // kNoTransversal: no transversal side at an end; kDisagreement: the two
@@ -559,6 +587,9 @@ std::string BandOptions::Check() const {
   } else if (!(hidden_end_max_offset_m > 0.0)) {
     error << "hidden_end_max_offset_m = " << hidden_end_max_offset_m
           << ": must be > 0";
+  } else if (min_end_direction_observations < 2) {
+    error << "min_end_direction_observations = "
+          << min_end_direction_observations << ": must be >= 2";
   }
   return error.str();
 }
@@ -683,7 +714,8 @@ bool ChooseTransversalPair(const std::vector<ImageLine>& begin,
 }
 
 bool RefineImageLine(const EdgeMap& edges, const Area& area,
-                     const BandOptions& options, ImageLine* line) {
+                     const BandOptions& options, ImageLine* line,
+                     const Eigen::Vector2d* fixed_normal) {
   // Sub-pixel edge positions along the line: at every pixel step along it,
   // the centroid of the gradient profile across it (the gradient projected
   // on the line's polarity, over the contiguous part above a third of its
@@ -768,7 +800,10 @@ bool RefineImageLine(const EdgeMap& edges, const Area& area,
         scatter += weights[k] * d * d.transpose();
       }
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
-      Eigen::Vector2d normal = solver.eigenvectors().col(0);
+      Eigen::Vector2d normal =
+          fixed_normal != nullptr
+              ? *fixed_normal
+              : Eigen::Vector2d(solver.eigenvectors().col(0));
       if (normal.dot(current.normal) < 0.0) normal = -normal;
       current.normal = normal;
       current.rho = normal.dot(mean);
@@ -1034,12 +1069,16 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
 
   // 3. Approximate transversal sides of each crossing: regression on the
   // extremities of its longer long sides (seen bands only).
-  for (int i = 0; i < m; ++i) {
+  for (int i = 0; i < m_all && VLOG_IS_ON(2); ++i) {
+    const LongSide& lo = sides[pairs[i].lo];
+    const Eigen::Vector3d centre_body = frame.To3d(
+        0.5 * (pairs[i].begin + pairs[i].end) * lo.direction_2d +
+        0.5 * (lo.lateral_m + sides[pairs[i].hi].lateral_m) * lo.Normal2d());
     VLOG(2) << "band " << i << ": sides " << pairs[i].lo << " " << pairs[i].hi
-            << " set " << sides[pairs[i].lo].direction_set << " lateral "
-            << sides[pairs[i].lo].lateral_m << " "
+            << " set " << lo.direction_set << " lateral " << lo.lateral_m << " "
             << sides[pairs[i].hi].lateral_m << " extent " << pairs[i].begin
-            << " " << pairs[i].end << " crossing " << crossing_of[i];
+            << " " << pairs[i].end << " crossing " << crossing_of[i]
+            << " centre_body " << centre_body.transpose();
   }
   std::vector<PlaneLine> begin_lines(crossings), end_lines(crossings);
   for (int c = 0; c < crossings; ++c) {
@@ -1077,6 +1116,8 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   // 4. Each band: plane, transversal sides, vertices. `known[e]`: the
   // transversal side of end e is not searched but taken from that line of
   // the plane frame (a hidden end, see below).
+  // Directions of the band ends seen in the first pass (step 4b).
+  std::vector<EndDirectionObservation>* end_directions = nullptr;
   auto model_band = [&](int i, const KnownEnd known[2],
                         Band* out) -> BandOutcome {
     const LongSide& lo = sides[pairs[i].lo];
@@ -1275,6 +1316,22 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                   << ": refinement failed";
           break;
         }
+        if (known[e].direction != nullptr) {
+          // The crossing's direction in this image, at this end.
+          const Eigen::Vector2d normal =
+              ImageNormalOf(rectification, side, frame, plane, areas_3d[e],
+                            *known[e].direction, transversal_lines[e].normal);
+          const double angle = std::acos(
+              std::min(1.0, std::abs(normal.dot(transversal_lines[e].normal))));
+          VLOG(2) << "band " << i << " side " << side << " end " << e << ": "
+                  << angle << " rad from the crossing's ends";
+          if (!(angle <= options.max_end_angle_rad) ||
+              !RefineImageLine(edges[side], areas[e], options,
+                               &transversal_lines[e], &normal)) {
+            failed = true;
+            break;
+          }
+        }
         line_sigma_px[side][e] = std::max(
             options.min_line_sigma_px,
             transversal_lines[e].rms_px /
@@ -1397,6 +1454,11 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                               (vertex_side[0][v] - vertex_side[1][v]).norm());
     }
     band.stereo_disagreement_m = disagreement;
+    for (int v = 0; v < 4; ++v) {
+      VLOG(3) << "band " << i << " vertex " << v << " left "
+              << vertex_side[0][v].transpose() << " right "
+              << vertex_side[1][v].transpose();
+    }
     const Eigen::Vector3d band_middle =
         0.25 * (band.vertices_body[0] + band.vertices_body[1] +
                 band.vertices_body[2] + band.vertices_body[3]);
@@ -1414,6 +1476,21 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     if (extrapolated && range > options.max_inferred_range_m) {
       VLOG(2) << "band " << i << ": extrapolated at range " << range;
       return BandOutcome::kRejected;
+    }
+    if (end_directions != nullptr && !extrapolated) {
+      // Each image's two ends, weighted by their angular precision: the
+      // along-band error of an end grows with the square of its range.
+      for (int side = 0; side < 2; ++side) {
+        for (int e = 0; e < 2; ++e) {
+          const Eigen::Vector3d& a = vertex_side[side][e == 0 ? 0 : 3];
+          const Eigen::Vector3d& b = vertex_side[side][e == 0 ? 1 : 2];
+          const double r =
+              (0.5 * (a + b) - rectification.left_centre_body()).norm();
+          end_directions->push_back(
+              {crossing, (frame.To2d(b) - frame.To2d(a)).normalized(),
+               1.0 / std::pow(std::max(r, 1.0), 4)});
+        }
+      }
     }
     if (disagreement > options.max_stereo_disagreement_m) {
       VLOG(2) << "band " << i << ": stereo disagreement " << disagreement;
@@ -1501,10 +1578,36 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
 
   std::vector<Band> bands;
   std::vector<int> without_transversal;
+  std::vector<EndDirectionObservation> observations;
+  end_directions = options.crossing_end_direction ? &observations : nullptr;
   const KnownEnd none[2];
+  std::vector<BandOutcome> outcomes(m_all);
+  std::vector<Band> first(m_all);
+  for (int i = 0; i < m_all; ++i) outcomes[i] = model_band(i, none, &first[i]);
+  end_directions = nullptr;
+  // 4b. The ends of a crossing's bands are parallel: the direction of its
+  // ends, from every band seen in both images and weighted by range, is
+  // far more precise than a far band's own (a 0.5 m end at 15 m spans a
+  // few original pixels: its angle is noisy, and its two vertices move
+  // apart, one forward, one back). Each band is modelled again with its
+  // ends fitted along that direction.
+  std::vector<Eigen::Vector2d> crossing_direction(crossings);
+  std::vector<char> has_direction(crossings, 0);
+  for (int c = 0; c < crossings && options.crossing_end_direction; ++c) {
+    has_direction[c] = CrossingEndDirection(
+        observations, c, options.min_end_direction_observations,
+        &crossing_direction[c]);
+  }
   for (int i = 0; i < m_all; ++i) {
-    Band band;
-    const BandOutcome outcome = model_band(i, none, &band);
+    Band band = first[i];
+    BandOutcome outcome = outcomes[i];
+    if (has_direction[crossing_of[i]]) {
+      KnownEnd along_crossing[2];
+      for (KnownEnd& k : along_crossing) {
+        k.direction = &crossing_direction[crossing_of[i]];
+      }
+      outcome = model_band(i, along_crossing, &band);
+    }
     if (outcome == BandOutcome::kBand) bands.push_back(band);
     if (outcome == BandOutcome::kNoTransversal ||
         outcome == BandOutcome::kDisagreement) {
@@ -1579,6 +1682,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       known[e].line = &lines[c][e];
       known[e].sigma_m = line_sigma[c][e];
       known[1 - e].expected = &lines[c][1 - e];
+      if (has_direction[c]) known[1 - e].direction = &crossing_direction[c];
       Band band;
       if (model_band(i, known, &band) != BandOutcome::kBand) continue;
       // The seen end on the crossing's line of that end.
