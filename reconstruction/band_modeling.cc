@@ -587,6 +587,9 @@ std::string BandOptions::Check() const {
   } else if (!(hidden_end_max_offset_m > 0.0)) {
     error << "hidden_end_max_offset_m = " << hidden_end_max_offset_m
           << ": must be > 0";
+  } else if (!(max_length_excess_m >= 0.0)) {
+    error << "max_length_excess_m = " << max_length_excess_m
+          << ": must be >= 0";
   } else if (min_end_direction_observations < 2) {
     error << "min_end_direction_observations = "
           << min_end_direction_observations << ": must be >= 2";
@@ -942,6 +945,13 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
           options.min_side_overlap_fraction * std::min(a1 - a0, b1 - b0)) {
         continue;
       }
+      // Longer than any band: the inner edge of a lane line and a kerb, or
+      // a lane line's two edges and a gutter, running along the crossing.
+      // Taken as one of its bands it would set the crossing's ends (the
+      // extremities of its longest bands) far from the painted ones.
+      if (overlap > zebra.max_band_length_m + options.max_length_excess_m) {
+        continue;
+      }
       // The paint is one band: no gap of asphalt between the two sides, i.e.
       // no side where the paint ends (darkening) followed by one where it
       // starts again (a side paired with the far edge of a lane line next
@@ -1172,6 +1182,9 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     vertex_sum.fill(Eigen::Vector3d::Zero());
     std::array<std::array<Eigen::Vector3d, 4>, 2> vertex_side;
     double line_sigma_px[2][2] = {{0, 0}, {0, 0}};
+    // Signed angle of each image's own end (free fit) from the crossing's
+    // direction of the ends, when it is known.
+    double free_angle[2][2] = {{0, 0}, {0, 0}};
     double contrast = 0.0;
     int views = 0;
     bool failed = false;
@@ -1321,14 +1334,13 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
           const Eigen::Vector2d normal =
               ImageNormalOf(rectification, side, frame, plane, areas_3d[e],
                             *known[e].direction, transversal_lines[e].normal);
-          const double angle = std::acos(
-              std::min(1.0, std::abs(normal.dot(transversal_lines[e].normal))));
+          const Eigen::Vector2d& own = transversal_lines[e].normal;
+          free_angle[side][e] = std::atan2(Cross(normal, own), normal.dot(own));
           VLOG(2) << "band " << i << " side " << side << " end " << e << ": "
-                  << angle << " rad from the crossing's ends";
-          if (!(angle <= options.max_end_angle_rad) ||
-              !RefineImageLine(edges[side], areas[e], options,
+                  << free_angle[side][e] << " rad from the crossing's ends";
+          if (!RefineImageLine(edges[side], areas[e], options,
                                &transversal_lines[e], &normal)) {
-            failed = true;
+            failed = transversal_failed = true;
             break;
           }
         }
@@ -1441,6 +1453,19 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       return transversal_failed ? BandOutcome::kNoTransversal
                                 : BandOutcome::kRejected;
     }
+    // A painted end is parallel to its crossing's (a stain's slanted edge
+    // cutting the paint is not): each end's own direction, averaged over
+    // the two images (a far end's angle is noisy in each), within
+    // max_end_angle_rad of the crossing's.
+    for (int e = 0; e < 2; ++e) {
+      if (known[e].direction == nullptr || known[e].line != nullptr) continue;
+      const double angle = 0.5 * (free_angle[0][e] + free_angle[1][e]);
+      if (!(std::abs(angle) <= options.max_end_angle_rad)) {
+        VLOG(2) << "band " << i << " end " << e << ": " << angle
+                << " rad from the crossing's ends";
+        return BandOutcome::kRejected;
+      }
+    }
 
     Band band;
     band.plane = plane;
@@ -1504,7 +1529,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     band.width_m = 0.5 * ((v1 - v0).norm() + (v2 - v3).norm()) *
                    std::abs(plane_fit.y_axis.dot((v1 - v0).normalized()));
     if (band.length_m < zebra.min_band_length_m - 0.5 ||
-        band.length_m > zebra.max_band_length_m + 0.5) {
+        band.length_m > zebra.max_band_length_m + options.max_length_excess_m) {
       VLOG(2) << "band " << i << ": length " << band.length_m;
       return BandOutcome::kRejected;
     }

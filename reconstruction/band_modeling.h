@@ -25,8 +25,12 @@ namespace zebrageo {
 struct BandOptions {
   // Long sides of one band are parallel within this angle.
   double max_side_angle_rad = 0.05;
-  // They overlap (along the band) over at least this share of the shorter.
+  // They overlap (along the band) over at least this share of the shorter,
+  // and over at most ZebraSpecification::max_band_length_m plus this: a
+  // longer pair is no band (a lane line's edge and the kerb beside a
+  // crossing).
   double min_side_overlap_fraction = 0.5;
+  double max_length_excess_m = 0.5;
   // The approximate transversal sides of a crossing come from the ends of
   // its long sides at least this share of the longest (the paper's 80 %).
   double extremity_length_fraction = 0.8;
