@@ -38,6 +38,9 @@ struct Group {
   double t_min = 0.0;  // extent along direction from centre
   double t_max = 0.0;
   double rms_m = 0.0;  // perpendicular residuals
+  // +1 when the image brightens across the group towards the left of
+  // `axis`, -1 the other way: one edge of a paint mark keeps its polarity.
+  int polarity = 1;
   double Length() const { return t_max - t_min; }
   Eigen::Vector2d Begin() const { return centre + t_min * direction; }
   Eigen::Vector2d End() const { return centre + t_max * direction; }
@@ -95,6 +98,9 @@ std::vector<Group> MergeCollinear(const std::vector<Eigen::Vector2d>& points,
       for (int j = i + 1; j < n; ++j) {
         const Group& a = groups[i];
         const Group& b = groups[j];
+        // A band's side running on into a lane line's opposite edge, or a
+        // shadow boundary, collinear with it is not one line.
+        if (a.polarity != b.polarity) continue;
         const double angle =
             std::acos(std::min(1.0, std::abs(a.direction.dot(b.direction))));
         // A short group's direction is uncertain: its angle may exceed the
@@ -134,6 +140,7 @@ std::vector<Group> MergeCollinear(const std::vector<Eigen::Vector2d>& points,
       support.insert(support.end(), groups[link.j].support.begin(),
                      groups[link.j].support.end());
       Group joined = MakeGroup(points, std::move(support), axis);
+      joined.polarity = groups[link.i].polarity;
       if (joined.rms_m > limits.max_offset_m) continue;
       touched[link.i] = touched[link.j] = 1;
       next.push_back(std::move(joined));
@@ -558,6 +565,11 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
           continue;
         }
         groups.push_back(MakeGroup(result.points_2d, s.support, direction));
+        double contrast = 0.0;
+        for (int i : s.support) {
+          contrast += result.points[i].gradient.dot(normal);
+        }
+        groups.back().polarity = contrast >= 0.0 ? 1 : -1;
       }
       groups =
           MergeCollinear(result.points_2d, std::move(groups), direction,

@@ -235,6 +235,37 @@ TEST(LongSides, RegularisationIgnoresAMismatchedPoint) {
   }
 }
 
+TEST(LongSides, ASideDoesNotRunOnIntoACollinearEdgeOfOppositePolarity) {
+  // The crossing of CrossingChains (x 5-8 m); the first side (y = 0,
+  // brightening into the band) continues, 1 m after the band's end, as the
+  // darkening edge of a lane line from x = 9 to 19 m.
+  std::vector<EdgeChain3d> chains = CrossingChains();
+  EdgeChain3d lane;
+  for (double x = 9.0; x <= 19.0; x += 0.01) {
+    EdgePoint3d p;
+    p.p_body = p.p_chain_body = Eigen::Vector3d(x, 0.0, 1.0);
+    p.gradient = Eigen::Vector2d(-30.0, 0.0);
+    lane.points.push_back(p);
+  }
+  chains.push_back(lane);
+  RoadPlane road;
+  road.offset_m = 1.0;
+  const PlaneFrame frame =
+      PlaneFrame::Make(road, Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero());
+  const LongSideDetection detection =
+      DetectLongSides(chains, frame, ZebraSpecification(), LongSideOptions());
+  int band_sides = 0;
+  for (const LongSide& side : detection.sides) {
+    if (std::abs(side.point_body.y()) > 0.1) continue;
+    // Either the band's side (5-8 m) or the lane line's edge (9-19 m).
+    const bool band =
+        side.contrast * frame.Direction3d(side.Normal2d()).y() > 0.0;
+    EXPECT_NEAR(side.Length(), band ? 3.0 : 10.0, 0.03);
+    band_sides += band;
+  }
+  EXPECT_EQ(band_sides, 1);
+}
+
 TEST(LongSides, CheckNamesTheBadField) {
   LongSideOptions options;
   options.min_long_side_length_m = 0.0;
