@@ -278,6 +278,25 @@ bool FitBandPlane(const std::vector<Eigen::Vector3d>& points,
   return true;
 }
 
+// FitBandPlane, then again without the points more than 3 rms (at least
+// 1 cm) off the plane (mismatched edge points).
+bool FitRobustBandPlane(std::vector<Eigen::Vector3d> points,
+                        const Eigen::Vector3d& along,
+                        const Eigen::Vector3d& normal, double min_sigma_m,
+                        BandPlaneFit* fit) {
+  if (!FitBandPlane(points, along, normal, min_sigma_m, fit)) return false;
+  const double limit = std::max(0.01, 3.0 * fit->rms_m);
+  const size_t before = points.size();
+  points.erase(std::remove_if(points.begin(), points.end(),
+                              [&](const Eigen::Vector3d& p) {
+                                return std::abs(fit->plane.SignedDistance(p)) >
+                                       limit;
+                              }),
+               points.end());
+  if (points.size() == before) return true;
+  return FitBandPlane(points, along, normal, min_sigma_m, fit);
+}
+
 struct BandCandidate {
   int lo = -1;  // side with the smaller lateral coordinate
   int hi = -1;
@@ -331,6 +350,27 @@ void Extent(const PlaneFrame& frame, const LongSide& side,
   const double b = frame.To2d(side.End()).dot(along);
   *low = std::min(a, b);
   *high = std::max(a, b);
+}
+
+// `side` fitted again on its points within `margin_m` of the band's extent
+// [begin_m, end_m] along its set's direction, when it runs on beyond that
+// by more than margin_m and at least half of its points are within.
+LongSide SideAlongBand(const std::vector<EdgePoint3d>& points,
+                       const PlaneFrame& frame, const LongSide& side,
+                       double begin_m, double end_m, double margin_m) {
+  double low, high;
+  Extent(frame, side, side.direction_2d, &low, &high);
+  if (low >= begin_m - margin_m && high <= end_m + margin_m) return side;
+  std::vector<int> within;
+  for (int p : side.support) {
+    const double t = frame.To2d(points[p].p_chain_body).dot(side.direction_2d);
+    if (t >= begin_m - margin_m && t <= end_m + margin_m) within.push_back(p);
+  }
+  if (2 * within.size() < side.support.size() || within.size() < 10) {
+    return side;
+  }
+  return FitLongSide(points, std::move(within), frame, side.direction_2d,
+                     side.direction_set);
 }
 
 // Completes the crossings: a long side that no band took, lying where the
@@ -1130,19 +1170,38 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   std::vector<EndDirectionObservation>* end_directions = nullptr;
   auto model_band = [&](int i, const KnownEnd known[2],
                         Band* out) -> BandOutcome {
-    const LongSide& lo = sides[pairs[i].lo];
-    const LongSide& hi = sides[pairs[i].hi];
+    // A seen side that runs on beyond the band (into a lane line, a
+    // vehicle's shadow edge, within the grouping's 3 cm) is fitted again
+    // on its points along the band: what it runs on to tilts its line.
+    LongSide lo = sides[pairs[i].lo];
+    LongSide hi = sides[pairs[i].hi];
+    if (pairs[i].inferred < 0) {
+      lo = SideAlongBand(detection.points, frame, lo, pairs[i].begin,
+                         pairs[i].end, options.transversal_search_m);
+      hi = SideAlongBand(detection.points, frame, hi, pairs[i].begin,
+                         pairs[i].end, options.transversal_search_m);
+    }
     const Eigen::Vector2d along = lo.direction_2d;
     const Eigen::Vector2d across = lo.Normal2d();
+    // The band plane from its sides' points along the band only: a side
+    // may run on beyond it (along a lane line, a vehicle's shadow), and
+    // what it runs on to may not lie on the road (a 3 cm height rms tilted
+    // a band's plane by 2 degrees and moved its ends 20 cm out, sim08).
     std::vector<Eigen::Vector3d> support;
-    for (int s : {pairs[i].lo, pairs[i].hi}) {
-      for (int p : sides[s].support) {
+    for (const LongSide* side : {&lo, &hi}) {
+      for (int p : side->support) {
+        const double t =
+            frame.To2d(detection.points[p].p_chain_body).dot(along);
+        if (t < pairs[i].begin - options.transversal_search_m ||
+            t > pairs[i].end + options.transversal_search_m) {
+          continue;
+        }
         support.push_back(detection.points[p].p_body);
       }
     }
     BandPlaneFit plane_fit;
-    if (!FitBandPlane(support, lo.direction_body, frame.normal,
-                      options.min_sigma_m, &plane_fit)) {
+    if (!FitRobustBandPlane(support, lo.direction_body, frame.normal,
+                            options.min_sigma_m, &plane_fit)) {
       return BandOutcome::kRejected;
     }
     const RoadPlane& plane = plane_fit.plane;

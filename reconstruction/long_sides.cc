@@ -478,6 +478,49 @@ std::vector<AccumulatorComponent> ParallelLineComponents(
   return components;
 }
 
+LongSide FitLongSide(const std::vector<EdgePoint3d>& points,
+                     std::vector<int> support, const PlaneFrame& frame,
+                     const Eigen::Vector2d& direction_2d, int direction_set) {
+  LongSide side;
+  side.direction_set = direction_set;
+  side.direction_2d = direction_2d;
+  const Eigen::Vector2d normal(-direction_2d.y(), direction_2d.x());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : support) mean += points[i].p_chain_body;
+  mean /= static_cast<double>(support.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int i : support) {
+    const Eigen::Vector3d d = points[i].p_chain_body - mean;
+    scatter += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  Eigen::Vector3d axis = solver.eigenvectors().col(2);
+  if (axis.dot(frame.Direction3d(direction_2d)) < 0.0) axis = -axis;
+  side.point_body = mean;
+  side.direction_body = axis;
+  side.t_begin = 1e30;
+  side.t_end = -1e30;
+  const Eigen::Vector3d across = frame.normal.cross(axis).normalized();
+  double lateral_ss = 0.0, height_ss = 0.0, contrast = 0.0;
+  for (int i : support) {
+    const Eigen::Vector3d d = points[i].p_chain_body - mean;
+    const double t = d.dot(axis);
+    side.t_begin = std::min(side.t_begin, t);
+    side.t_end = std::max(side.t_end, t);
+    const Eigen::Vector3d r = d - t * axis;
+    lateral_ss += r.dot(across) * r.dot(across);
+    height_ss += r.dot(frame.normal) * r.dot(frame.normal);
+    contrast += points[i].gradient.dot(normal);
+  }
+  const double count = static_cast<double>(support.size());
+  side.lateral_rms_m = std::sqrt(lateral_ss / count);
+  side.height_rms_m = std::sqrt(height_ss / count);
+  side.contrast = contrast / count;
+  side.lateral_m = frame.To2d(mean).dot(normal);
+  side.support = std::move(support);
+  return side;
+}
+
 LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
                                   const PlaneFrame& frame,
                                   const ZebraSpecification& zebra,
@@ -588,43 +631,8 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
       for (Group& g : groups) {
         VLOG(3) << "  group length " << g.Length() << " rms " << g.rms_m;
         if (g.Length() < options.min_long_side_length_m) continue;
-        // 3D regression on the group's points.
-        LongSide side;
-        side.direction_set = set;
-        side.direction_2d = direction;
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (int i : g.support) mean += result.points[i].p_chain_body;
-        mean /= static_cast<double>(g.support.size());
-        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-        for (int i : g.support) {
-          const Eigen::Vector3d d = result.points[i].p_chain_body - mean;
-          scatter += d * d.transpose();
-        }
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
-        Eigen::Vector3d axis = solver.eigenvectors().col(2);
-        if (axis.dot(frame.Direction3d(direction)) < 0.0) axis = -axis;
-        side.point_body = mean;
-        side.direction_body = axis;
-        side.t_begin = 1e30;
-        side.t_end = -1e30;
-        const Eigen::Vector3d across = frame.normal.cross(axis).normalized();
-        double lateral_ss = 0.0, height_ss = 0.0, contrast = 0.0;
-        for (int i : g.support) {
-          const Eigen::Vector3d d = result.points[i].p_chain_body - mean;
-          const double t = d.dot(axis);
-          side.t_begin = std::min(side.t_begin, t);
-          side.t_end = std::max(side.t_end, t);
-          const Eigen::Vector3d r = d - t * axis;
-          lateral_ss += r.dot(across) * r.dot(across);
-          height_ss += r.dot(frame.normal) * r.dot(frame.normal);
-          contrast += result.points[i].gradient.dot(normal);
-        }
-        const double count = static_cast<double>(g.support.size());
-        side.lateral_rms_m = std::sqrt(lateral_ss / count);
-        side.height_rms_m = std::sqrt(height_ss / count);
-        side.contrast = contrast / count;
-        side.lateral_m = frame.To2d(mean).dot(normal);
-        side.support = std::move(g.support);
+        LongSide side = FitLongSide(result.points, std::move(g.support),
+                                    frame, direction, set);
         VLOG(2) << "long side " << result.sides.size() << ": set " << set
                 << " lateral " << side.lateral_m << " extent " << side.t_begin
                 << " " << side.t_end << " contrast " << side.contrast

@@ -204,6 +204,13 @@ struct LongSideDetection {
   std::vector<LongSide> sides;
 };
 
+// The 3D line (total least squares) of the points `support` (indices into
+// `points`, their p_chain_body), oriented along `direction_2d` of the plane
+// frame, with its extent, residuals and contrast across direction_2d.
+LongSide FitLongSide(const std::vector<EdgePoint3d>& points,
+                     std::vector<int> support, const PlaneFrame& frame,
+                     const Eigen::Vector2d& direction_2d, int direction_set);
+
 LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
                                   const PlaneFrame& frame,
                                   const ZebraSpecification& zebra,
