@@ -373,6 +373,26 @@ LongSide SideAlongBand(const std::vector<EdgePoint3d>& points,
                      side.direction_set);
 }
 
+// Least-squares line y = a + b x through the points (p[0], p[index]):
+// {a, b}; b = 0 when the x spread is below 1 cm.
+std::array<double, 2> LinearFit(const std::vector<std::array<double, 3>>& p,
+                                int index) {
+  double mean_x = 0.0, mean_y = 0.0;
+  for (const auto& q : p) {
+    mean_x += q[0];
+    mean_y += q[index];
+  }
+  mean_x /= static_cast<double>(p.size());
+  mean_y /= static_cast<double>(p.size());
+  double sxx = 0.0, sxy = 0.0;
+  for (const auto& q : p) {
+    sxx += (q[0] - mean_x) * (q[0] - mean_x);
+    sxy += (q[0] - mean_x) * (q[index] - mean_y);
+  }
+  const double b = sxx > 1e-4 * static_cast<double>(p.size()) ? sxy / sxx : 0.0;
+  return {mean_y - b * mean_x, b};
+}
+
 // Completes the crossings: a long side that no band took, lying where the
 // crossing's regular pattern expects a band side (one band width from the
 // slot of a missing band, with the polarity of that side), becomes a band
@@ -391,7 +411,8 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
   const int n = static_cast<int>(side_used.size());
   const int m = static_cast<int>(pairs->size());
   for (int c = 0; c < crossings; ++c) {
-    std::vector<double> centres, widths, contrasts, begins, ends;
+    std::vector<double> centres, widths, contrasts, lengths;
+    std::vector<std::array<double, 3>> extents;  // (centre, begin, end)
     int set = -1;
     Eigen::Vector3d direction_body = Eigen::Vector3d::Zero();
     Eigen::Vector2d along = Eigen::Vector2d::UnitX();
@@ -400,11 +421,12 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
       const LongSide& lo = (*sides)[(*pairs)[i].lo];
       const LongSide& hi = (*sides)[(*pairs)[i].hi];
       centres.push_back(0.5 * (lo.lateral_m + hi.lateral_m));
+      extents.push_back({centres.back(), (*pairs)[i].begin, (*pairs)[i].end});
       widths.push_back(hi.lateral_m - lo.lateral_m);
       contrasts.push_back(std::abs(lo.contrast));
       contrasts.push_back(std::abs(hi.contrast));
-      begins.push_back((*pairs)[i].begin);
-      ends.push_back((*pairs)[i].end);
+      lengths.push_back(lo.Length());
+      lengths.push_back(hi.Length());
       set = lo.direction_set;
       direction_body = lo.direction_body;
       along = lo.direction_2d;
@@ -442,8 +464,10 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
           irregular || std::abs(d - period) > options.completion_tolerance_m;
     }
     if (irregular) continue;
-    const double begin = MedianOf(begins);
-    const double end = MedianOf(ends);
+    // A skewed crossing's bands are offset along the band: its ends are
+    // lines across the bands, begin and end linear in the lateral position.
+    const std::array<double, 2> begin_line = LinearFit(extents, 1);
+    const std::array<double, 2> end_line = LinearFit(extents, 2);
     const double min_contrast = 0.5 * MedianOf(contrasts);
     // Best side for each empty slot (index from the first band).
     std::map<int, std::pair<double, int>> best;  // slot -> (residual, side)
@@ -456,18 +480,21 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
         continue;
       }
       if (std::abs(s.contrast) < min_contrast) continue;
-      // Within the crossing along the band, and no longer than its bands (a
-      // lane line is).
+      // Paint brightens towards +lateral at the low side of a band.
+      const double centre =
+          s.lateral_m + (s.contrast > 0.0 ? 0.5 : -0.5) * width;
+      // Within the crossing along the band, and no longer than its bands'
+      // sides (a lane line is; a side is longer than its band's overlap
+      // with the other side).
+      const double begin = begin_line[0] + begin_line[1] * centre;
+      const double end = end_line[0] + end_line[1] * centre;
       double s0, s1;
       Extent(frame, s, along, &s0, &s1);
-      if (s1 - s0 > end - begin + options.completion_tolerance_m * 5.0 ||
+      if (s1 - s0 > MedianOf(lengths) + options.completion_tolerance_m * 5.0 ||
           std::min(s1, end) - std::max(s0, begin) <
               options.min_side_overlap_fraction * (s1 - s0)) {
         continue;
       }
-      // Paint brightens towards +lateral at the low side of a band.
-      const double centre =
-          s.lateral_m + (s.contrast > 0.0 ? 0.5 : -0.5) * width;
       const double position = (centre - centres.front()) / period;
       const int slot = static_cast<int>(std::lround(position));
       const double residual = std::abs(position - slot) * period;
@@ -1088,10 +1115,14 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       const double b_hi = sides[pairs[j].hi].lateral_m;
       const double gap = std::max(b_lo.lateral_m - a_hi, a_lo.lateral_m - b_hi);
       if (gap > options.max_crossing_gap_m) continue;
-      double a0, a1, b0, b1;
-      Extent(frame, a_lo, a_lo.direction_2d, &a0, &a1);
-      Extent(frame, b_lo, a_lo.direction_2d, &b0, &b1);
-      if (std::min(a1, b1) - std::max(a0, b0) <= 0.0) continue;
+      // The bands themselves overlap along their direction, not only
+      // their sides: a side may run on along a lane line, and a pair of
+      // lines before the crossing would join it and set its ends.
+      if (std::min(pairs[i].end, pairs[j].end) -
+              std::max(pairs[i].begin, pairs[j].begin) <=
+          0.0) {
+        continue;
+      }
       parent[Root(&parent, i)] = Root(&parent, j);
     }
   }
