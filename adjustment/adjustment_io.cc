@@ -3,11 +3,14 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
@@ -126,14 +129,14 @@ nlohmann::json SummaryJson(const AdjustmentData& data,
   j["rig"] = rig;
   j["model"] = {
       {"knot_spacing_s", options.knot_spacing_s},
-      {"gnss_sigma_horizontal_m", s.gnss_sigma_horizontal_m},
-      {"gnss_sigma_vertical_m", s.gnss_sigma_vertical_m},
-      {"gnss_sigma_estimated", options.estimate_gnss_sigma},
-      {"prior_correlation_time_s", options.prior_correlation_time_s},
-      {"ins_tilt_sigma_deg", options.ins_tilt_sigma_deg},
-      {"ins_heading_sigma_deg", options.ins_heading_sigma_deg},
-      {"drift_rate_sigma_mps", options.drift_rate_sigma_mps},
-      {"drift_acceleration_sigma_mps2", options.drift_acceleration_sigma_mps2},
+      {"position_model_estimated", options.estimate_position_model},
+      // Along-track, cross-track, up.
+      {"position_sigma_m", Vector3Json(s.position_sigma_m)},
+      {"position_tau_s", Vector3Json(s.position_tau_s)},
+      {"attitude_sigma_deg", Vector3Json(RadToDeg(1.0) * s.attitude_sigma_rad)},
+      {"vehicle_motion_sigma_deg",
+       {RadToDeg(s.motion_sigma_rad.x()), RadToDeg(s.motion_sigma_rad.y())}},
+      {"tie_sigma_px", s.tie_sigma_px},
       {"vertex_sigma_px", options.vertex_sigma_px},
       {"crossing_offset_sigma_m", options.crossing_offset_sigma_m},
       {"check_crossing_share", options.check_crossing_share},
@@ -301,10 +304,11 @@ AdjustmentInput AdjustmentData::Input() const {
 }
 
 AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
-                                  const std::string& results_folder) {
+                                  const std::string& results_folder,
+                                  const SurveyPathOptions& paths) {
   AdjustmentData data;
   data.survey_folder = survey_folder;
-  data.manifest = ReadManifest(survey_folder);
+  data.manifest = ReadManifest(survey_folder, paths);
   auto path_of = [&](const std::string& name) {
     return (fs::path(survey_folder) / name).string();
   };
@@ -409,6 +413,63 @@ void WriteAdjustmentResults(const AdjustmentData& data,
   WriteTrajectorySamples(result.corrected_samples,
                          out(kTrajectoryCorrectedFile));
   WriteCameraPoses(result.camera_poses, out(kPosesFile));
+}
+
+int RemoveRejectedMatches(const AdjustmentData& data,
+                          const AdjustmentResult& result,
+                          const std::string& results_folder) {
+  std::set<std::tuple<std::string, int, int>> rejected;
+  std::set<std::string> rejected_crossings;
+  for (const ControlPointResult& p : result.control_points) {
+    if (p.status != ControlStatus::kRejected) continue;
+    rejected.insert({p.crossing_id, p.band, p.db_vertex});
+    rejected_crossings.insert(p.crossing_id);
+  }
+  if (rejected.empty()) return 0;
+  std::vector<VertexMatch> kept;
+  std::map<int64_t, int> kept_per_exposure;
+  std::set<int64_t> touched;
+  for (const VertexMatch& m : data.matches) {
+    if (rejected.count({m.crossing_id, m.band, m.db_vertex})) {
+      touched.insert(m.exposure_id);
+      continue;
+    }
+    kept.push_back(m);
+    ++kept_per_exposure[m.exposure_id];
+  }
+  const int removed = static_cast<int>(data.matches.size() - kept.size());
+  if (removed == 0) return 0;
+  const fs::path folder(results_folder);
+  std::string names;
+  for (const std::string& id : rejected_crossings) {
+    names += (names.empty() ? "" : " ") + id;
+  }
+  WriteMatches(kept,
+               {"zebrageo adjust removed " + std::to_string(removed) +
+                " vertex matches the adjustment rejected (crossings " + names +
+                "; gcp_residuals.csv, report.json warnings)"},
+               (folder / kMatchesFile).string());
+  const fs::path decisions_path = folder / kCrossingDecisionsFile;
+  if (fs::exists(decisions_path)) {
+    std::vector<CrossingDecision> decisions =
+        ReadCrossingDecisions(decisions_path.string(), kCrossingDecisionsFile);
+    for (CrossingDecision& d : decisions) {
+      if (d.decision != Decision::kMatched || !touched.count(d.exposure_id) ||
+          kept_per_exposure.count(d.exposure_id)) {
+        continue;
+      }
+      d.reason = "matched to " + d.crossing_id +
+                 ", then rejected by the adjustment: inconsistent with the "
+                 "other crossings and the trajectory (report.json warnings); "
+                 "was: " +
+                 d.reason;
+      d.decision = Decision::kRefused;
+      d.crossing_id.clear();
+    }
+    WriteCrossingDecisions(decisions, {"zebrageo match, then adjust"},
+                           decisions_path.string());
+  }
+  return removed;
 }
 
 }  // namespace zebrageo

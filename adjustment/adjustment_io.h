@@ -52,11 +52,13 @@ struct AdjustmentData {
   AdjustmentInput Input() const;
 };
 
-// Throws InputError: any survey file the readers reject, exposures outside
+// Throws InputError: any survey file the readers reject (survey.yaml's
+// files confined to the survey folder as `paths` says), exposures outside
 // the trajectory, a missing or malformed reconstructed_bands.csv or
 // matches.csv (the message says which stage to run first).
 AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
-                                  const std::string& results_folder);
+                                  const std::string& results_folder,
+                                  const SurveyPathOptions& paths = {});
 
 // Writes every output listed above into `results_folder` (created if
 // needed). `tie_summary` may be null (no tie points). Throws
@@ -66,6 +68,17 @@ void WriteAdjustmentResults(const AdjustmentData& data,
                             const AdjustmentResult& result,
                             const TiePointSummary* tie_summary,
                             const std::string& results_folder);
+
+// matches.csv holds the vertices that became control points
+// (SURVEY_FORMAT.md): the ones the adjustment rejected (a crossing
+// inconsistent with the others, matched one band off; a blunder) are
+// removed from it, and an observation left without any is refused in
+// crossing_decisions.csv, with the reason. Both rewritten atomically, only
+// when something was rejected. Returns the number of vertex matches
+// removed.
+int RemoveRejectedMatches(const AdjustmentData& data,
+                          const AdjustmentResult& result,
+                          const std::string& results_folder);
 
 // Writes the gcp_residuals.csv rows of `points` to `path`.
 void WriteGcpResidualsWithStatus(const std::vector<ControlPointResult>& points,

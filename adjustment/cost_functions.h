@@ -13,8 +13,11 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
+#include <vector>
 
 #include "adjustment/trajectory_correction.h"
 #include "survey/camera.h"
@@ -327,6 +330,294 @@ class LinearPrior : public RepeatedBlocksCostFunction<M, N>::type {
   Matrix S_;
   std::array<double, N> a_;
   Vector b_;
+};
+
+// The first-order Gauss-Markov prior of three components (offset, offset
+// + 1, offset + 2) of the knots: for the first knot (one block)
+//   r_i = (c_0[j] - b_0[j]) / sigma_i,
+// for the others (blocks k - 1, k)
+//   r_i = ((c_k[j] - b_k[j]) - phi_i (c_{k-1}[j] - b_{k-1}[j]))
+//         / (sigma_i sqrt(1 - phi_i^2)),
+// j = offset + i, phi_i = exp(-knot_spacing / tau_i): the innovations of a
+// correlated process, independent of each other (adjustment_state.h).
+class KnotProcessPrior : public ceres::CostFunction {
+ public:
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  // The first knot's prior: b = b_0.
+  static ceres::CostFunction* CreateFirst(int offset,
+                                          const Eigen::Vector3d& sigma,
+                                          const Vector6& b) {
+    return new KnotProcessPrior(offset, sigma, Eigen::Vector3d::Zero(), b,
+                                Vector6::Zero(), false);
+  }
+  // The innovation from knot k - 1 (first block) to knot k (second).
+  static ceres::CostFunction* CreateStep(int offset,
+                                         const Eigen::Vector3d& sigma,
+                                         const Eigen::Vector3d& phi,
+                                         const Vector6& b_previous,
+                                         const Vector6& b) {
+    return new KnotProcessPrior(offset, sigma, phi, b, b_previous, true);
+  }
+
+  bool Evaluate(double const* const* x, double* residuals,
+                double** jacobians) const override {
+    const double* current = step_ ? x[1] : x[0];
+    for (int i = 0; i < 3; ++i) {
+      const int j = offset_ + i;
+      double e = current[j] - b_[j];
+      if (step_) e -= phi_[i] * (x[0][j] - b_previous_[j]);
+      residuals[i] = s_[i] * e;
+    }
+    if (jacobians == nullptr) return true;
+    for (int block = 0; block < (step_ ? 2 : 1); ++block) {
+      if (jacobians[block] == nullptr) continue;
+      Eigen::Map<Eigen::Matrix<double, 3, 6, Eigen::RowMajor>> J(
+          jacobians[block]);
+      J.setZero();
+      const bool is_current = !step_ || block == 1;
+      for (int i = 0; i < 3; ++i) {
+        J(i, offset_ + i) = is_current ? s_[i] : -phi_[i] * s_[i];
+      }
+    }
+    return true;
+  }
+
+ private:
+  KnotProcessPrior(int offset, const Eigen::Vector3d& sigma,
+                   const Eigen::Vector3d& phi, const Vector6& b,
+                   const Vector6& b_previous, bool step)
+      : offset_(offset),
+        phi_(phi),
+        b_(b),
+        b_previous_(b_previous),
+        step_(step) {
+    for (int i = 0; i < 3; ++i) {
+      const double innovation =
+          step ? std::sqrt(std::max(1e-12, 1.0 - phi[i] * phi[i])) : 1.0;
+      s_[i] = 1.0 / (sigma[i] * innovation);
+    }
+    set_num_residuals(3);
+    mutable_parameter_block_sizes()->assign(step ? 2 : 1, kKnotSize);
+  }
+
+  int offset_;
+  Eigen::Vector3d phi_;
+  Vector6 b_;
+  Vector6 b_previous_;
+  bool step_;
+  Eigen::Vector3d s_;
+};
+
+// A control vertex as the stereo pair of one exposure reconstructed it:
+// its body-frame position and covariance (reconstructed_bands.csv), against
+// the point (ENU) placed in the body frame by the corrected trajectory:
+//   dtheta = R_enu_track c[0:3], dp = R_enu_track c[3:6]
+//   r      = S (R_ins^T Exp(-dtheta) (X_enu - p_ins - dp) - p_body)
+// S the whitening of the body covariance. Each exposure's observation then
+// depends on that exposure's pose alone: unlike the reprojection of one
+// point into several exposures, a small error of the INS relative motion
+// between exposures cannot shift the point along the viewing direction
+// (the motion parallax of a point 10-15 m ahead is a weak, easily biased
+// measure of its depth; the rig's stereo baseline is not).
+class StereoVertexError {
+ public:
+  StereoVertexError(const Eigen::Vector3d& p_body,
+                    const Eigen::Matrix3d& sqrt_information,
+                    const Pose& ins_pose, const Eigen::Matrix3d& R_enu_track)
+      : p_body_(p_body),
+        sqrt_information_(sqrt_information),
+        R_body_enu_ins_(ins_pose.q_enu_body.toRotationMatrix().transpose()),
+        p_enu_ins_(ins_pose.p_enu),
+        R_enu_track_(R_enu_track) {}
+
+  template <typename T>
+  bool operator()(const T* const c, const T* const point_enu,
+                  T* residuals) const {
+    T d[3];
+    T minus_dtheta[3];
+    for (int i = 0; i < 3; ++i) {
+      d[i] = point_enu[i] - p_enu_ins_[i] -
+             (R_enu_track_(i, 0) * c[3] + R_enu_track_(i, 1) * c[4] +
+              R_enu_track_(i, 2) * c[5]);
+      minus_dtheta[i] =
+          -(R_enu_track_(i, 0) * c[0] + R_enu_track_(i, 1) * c[1] +
+            R_enu_track_(i, 2) * c[2]);
+    }
+    T v[3];
+    ceres::AngleAxisRotatePoint(minus_dtheta, d, v);
+    T e[3];
+    for (int r = 0; r < 3; ++r) {
+      e[r] = R_body_enu_ins_(r, 0) * v[0] + R_body_enu_ins_(r, 1) * v[1] +
+             R_body_enu_ins_(r, 2) * v[2] - p_body_[r];
+    }
+    for (int r = 0; r < 3; ++r) {
+      residuals[r] = sqrt_information_(r, 0) * e[0] +
+                     sqrt_information_(r, 1) * e[1] +
+                     sqrt_information_(r, 2) * e[2];
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d p_body_;
+  Eigen::Matrix3d sqrt_information_;
+  Eigen::Matrix3d R_body_enu_ins_;
+  Eigen::Vector3d p_enu_ins_;
+  Eigen::Matrix3d R_enu_track_;
+};
+
+// StereoVertexError chained to the 4 knots at the exposure, then the point.
+class SplineStereoVertexCost
+    : public ceres::SizedCostFunction<3, kKnotSize, kKnotSize, kKnotSize,
+                                      kKnotSize, 3> {
+ public:
+  SplineStereoVertexCost(const StereoVertexError& error,
+                         const double weights[4])
+      : error_(
+            new ceres::AutoDiffCostFunction<StereoVertexError, 3, kKnotSize, 3>(
+                new StereoVertexError(error))) {
+    for (int j = 0; j < 4; ++j) weights_[j] = weights[j];
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    double c[kKnotSize];
+    internal::SplineCorrection(weights_, parameters, c);
+    const double* inner[2] = {c, parameters[4]};
+    if (jacobians == nullptr) {
+      return error_->Evaluate(inner, residuals, nullptr);
+    }
+    double d_c[3 * kKnotSize];
+    double* inner_jacobians[2] = {d_c, jacobians[4]};
+    if (!error_->Evaluate(inner, residuals, inner_jacobians)) return false;
+    for (int j = 0; j < 4; ++j) {
+      if (jacobians[j] == nullptr) continue;
+      for (int i = 0; i < 3 * kKnotSize; ++i) {
+        jacobians[j][i] = weights_[j] * d_c[i];
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> error_;
+  double weights_[4];
+};
+
+// A residual whose first four blocks are the knots of the spline at an
+// exposure (SplineReprojectionCost, LinePointCost), with the exposure's
+// fast position offset delta (3, track frame: the jitter of the GNSS/INS
+// positions, adjustment_state.h) added to the correction there:
+//   c = sum_j w_j k_j + [0, delta] = sum_j w_j (k_j + [0, delta])
+// since the weights sum to 1. The inner cost sees the shifted knots; the
+// offset block comes last, dr/ddelta = sum_j dr/dk_j[:, 3:6].
+class WithExposureOffset : public ceres::CostFunction {
+ public:
+  // Takes ownership of `inner`.
+  explicit WithExposureOffset(ceres::CostFunction* inner) : inner_(inner) {
+    *mutable_parameter_block_sizes() = inner->parameter_block_sizes();
+    mutable_parameter_block_sizes()->push_back(3);
+    set_num_residuals(inner->num_residuals());
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int blocks = static_cast<int>(inner_->parameter_block_sizes().size());
+    const double* delta = parameters[blocks];
+    std::array<std::array<double, kKnotSize>, 4> knots;
+    std::vector<const double*> inner(parameters, parameters + blocks);
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < kKnotSize; ++i) {
+        knots[j][i] = parameters[j][i] + (i >= 3 ? delta[i - 3] : 0.0);
+      }
+      inner[j] = knots[j].data();
+    }
+    if (jacobians == nullptr) {
+      return inner_->Evaluate(inner.data(), residuals, nullptr);
+    }
+    const int m = num_residuals();
+    // The knots' Jacobians are needed for delta's even when Ceres does not
+    // ask for them.
+    std::vector<std::vector<double>> own(4);
+    std::vector<double*> inner_jacobians(jacobians, jacobians + blocks);
+    for (int j = 0; j < 4; ++j) {
+      if (inner_jacobians[j] == nullptr) {
+        own[j].resize(m * kKnotSize);
+        inner_jacobians[j] = own[j].data();
+      }
+    }
+    if (!inner_->Evaluate(inner.data(), residuals, inner_jacobians.data())) {
+      return false;
+    }
+    if (jacobians[blocks] != nullptr) {
+      for (int r = 0; r < m; ++r) {
+        for (int i = 0; i < 3; ++i) {
+          double sum = 0.0;
+          for (int j = 0; j < 4; ++j) {
+            sum += inner_jacobians[j][r * kKnotSize + 3 + i];
+          }
+          jacobians[blocks][r * 3 + i] = sum;
+        }
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> inner_;
+};
+
+// The first-order Gauss-Markov prior of a sequence of 3-vectors (the
+// exposures' fast position offsets): for the first, r = x_0 / sigma; then
+//   r = (x_k - phi x_{k-1}) / (sigma sqrt(1 - phi^2)),
+// per component, phi = exp(-dt / tau) with dt the time between the two.
+class VectorProcessPrior : public ceres::CostFunction {
+ public:
+  static ceres::CostFunction* CreateFirst(const Eigen::Vector3d& sigma) {
+    return new VectorProcessPrior(sigma, Eigen::Vector3d::Zero(), false);
+  }
+  static ceres::CostFunction* CreateStep(const Eigen::Vector3d& sigma,
+                                         const Eigen::Vector3d& phi) {
+    return new VectorProcessPrior(sigma, phi, true);
+  }
+
+  bool Evaluate(double const* const* x, double* residuals,
+                double** jacobians) const override {
+    const double* current = step_ ? x[1] : x[0];
+    for (int i = 0; i < 3; ++i) {
+      double e = current[i];
+      if (step_) e -= phi_[i] * x[0][i];
+      residuals[i] = s_[i] * e;
+    }
+    if (jacobians == nullptr) return true;
+    for (int block = 0; block < (step_ ? 2 : 1); ++block) {
+      if (jacobians[block] == nullptr) continue;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J(
+          jacobians[block]);
+      J.setZero();
+      const bool is_current = !step_ || block == 1;
+      for (int i = 0; i < 3; ++i) {
+        J(i, i) = is_current ? s_[i] : -phi_[i] * s_[i];
+      }
+    }
+    return true;
+  }
+
+ private:
+  VectorProcessPrior(const Eigen::Vector3d& sigma, const Eigen::Vector3d& phi,
+                     bool step)
+      : phi_(phi), step_(step) {
+    for (int i = 0; i < 3; ++i) {
+      const double innovation =
+          step ? std::sqrt(std::max(1e-12, 1.0 - phi[i] * phi[i])) : 1.0;
+      s_[i] = 1.0 / (sigma[i] * innovation);
+    }
+    set_num_residuals(3);
+    mutable_parameter_block_sizes()->assign(step ? 2 : 1, 3);
+  }
+
+  Eigen::Vector3d phi_;
+  bool step_;
+  Eigen::Vector3d s_;
 };
 
 }  // namespace zebrageo

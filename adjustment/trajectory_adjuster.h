@@ -14,27 +14,28 @@
 //   - the database position of each control vertex (sigma_xy, sigma_z of
 //     the database) plus its crossing's offset (crossing_offset_sigma_m),
 //     Cauchy loss;
-//   - the GNSS/INS solution: the correction at each knot is 0 +- gnss_*,
-//     counted once per prior_correlation_time_s (Cauchy loss: a GNSS jump
-//     is an outlier, not a constraint); gnss_* are estimated from the
-//     control first (variance components: what the crossings' discrepancies
-//     hold beyond the database's own error), so a drift smaller than the
-//     database's error is not "corrected" into that error;
+//   - the GNSS/INS solution: the correction is a correlated (Gauss-Markov)
+//     process whose sigma and correlation time are estimated from the
+//     control for the position and taken from the trajectory's own sd_* for
+//     the attitude (see AdjustmentOptions); where the positions jitter from
+//     sample to sample, each exposure has its own offset on top
+//     (trajectory_jitter.h);
 //   - the vehicle's motion: it moves along its heading (vehicle_motion.h),
-//     sigma sideslip_sigma_deg per constraint, Cauchy loss;
-//   - the INS relative motion: the drift rate (first difference of knots,
-//     at most what a Gauss-Markov drift of sigma gnss_* and correlation
-//     time prior_correlation_time_s allows) and its change (second
-//     difference) are small; they set how fast the correction may vary
-//     between control points.
-// Solved with Ceres (SPARSE_SCHUR on SuiteSparse: points eliminated, the
-// banded knot system factorised), first without robust losses to take out
-// the drift, then robustly; then control vertices whose image-only position
+//     Cauchy loss; road-line points (line_control.h), Cauchy loss.
+// The soft constraints' sigmas are checked against their residuals and
+// widened where the data show more spread (variance components). Solved
+// with Ceres (SPARSE_SCHUR on SuiteSparse: points eliminated, the banded
+// knot system factorised), first without robust losses to take out the
+// drift, then robustly; then control vertices whose image-only position
 // disagrees with the database (normalised residual above
-// blunder_threshold) are removed and the adjustment repeated. A share of
-// crossings is held out as check points: their residuals come from an
-// adjustment without them; the final adjustment then uses them as control
-// (check_points_in_final).
+// blunder_threshold) are removed and the adjustment repeated. Before that,
+// each crossing is tested against the others and the GNSS/INS error model
+// (control_selection.h): the largest consistent set is kept, a crossing one
+// band period away from it is named as such. A share of crossings is held
+// out as check points: their residuals come from an adjustment without
+// them; the final adjustment then uses them as control
+// (check_points_in_final). Without any usable control the input trajectory
+// is returned unchanged.
 #ifndef ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 #define ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 
@@ -49,6 +50,7 @@
 #include "adjustment/trajectory_correction.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
+#include "survey/math_util.h"
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
@@ -65,44 +67,48 @@ struct AdjustmentOptions {
   // Express the correction in the track frame (along-track, cross-track,
   // up: dead-reckoning errors turn with the vehicle) or in ENU.
   bool track_frame = true;
-  // The GNSS/INS absolute position, per knot: realistic, not the file's
-  // optimistic sd_* (urban drift reaches metres). Cauchy loss of scale
-  // gnss_loss_scale (in sigmas).
-  double gnss_sigma_horizontal_m = 1.0;
-  double gnss_sigma_vertical_m = 1.0;
-  double gnss_loss_scale = 1.0;
-  // Variance component estimation of the two sigmas above (upper bounds
-  // then): the mean square discrepancy between the control crossings and
-  // the INS trajectory, minus the database's own error. A drift the control
-  // does not show beyond the database's error is then not "corrected" into
-  // that error (an adjustment must not make the trajectory worse).
-  bool estimate_gnss_sigma = true;
-  double min_gnss_sigma_m = 0.03;
-  // The INS absolute attitude, tilt and heading apart: they drift
-  // differently. Tilt (roll, pitch) is held by gravity; its prior holds per
-  // knot (0.2 deg per knot bounds the mean tilt correction over the
-  // correlation time to about 0.04 deg, a tactical-grade INS's tilt drift),
-  // and the data hold tilt only weakly (a crossing's database heights give
-  // its tilt to about 0.2 deg). Heading drifts like the position (a few
-  // hundredths of a degree to a tenth), once per prior_correlation_time_s:
-  // counting it per knot would hold the heading to the INS's where only
-  // the vehicle's motion and road lines control it. A better INS: lower
-  // ins_tilt_sigma_deg.
-  double ins_tilt_sigma_deg = 0.2;
-  double ins_heading_sigma_deg = 0.2;
-  // Correlation time of the GNSS/INS error (its drift): the two priors
-  // above hold once per this time, so each knot's prior is widened by
-  // sqrt(prior_correlation_time_s / knot_spacing_s).
-  double prior_correlation_time_s = 30.0;
-  // Drift rate: how fast the position/attitude error may change (first
-  // difference of knots / spacing), per knot interval.
-  double drift_rate_sigma_mps = 0.2;
-  double drift_rate_sigma_deg_per_s = 0.02;
-  // Change of the drift rate (second difference / spacing^2): the smoothness
-  // of the correction between control points. A drift of peak A and period
-  // T has an acceleration of A (2 pi / T)^2: 2 m over 60 s gives 0.02.
-  double drift_acceleration_sigma_mps2 = 0.01;
-  double drift_angular_acceleration_sigma_deg_per_s2 = 0.001;
+  // The GNSS/INS error is modelled as what it is, a correlated process:
+  // each component of the correction (attitude about along-track,
+  // cross-track and up; position along-track, cross-track and up) is a
+  // first-order Gauss-Markov process of standard deviation sigma and
+  // correlation time tau (adjustment_state.h). Its innovations, not its
+  // values, are independent: a drift is counted a few times per correlation
+  // time, never once per knot, so the correction reaches the control where
+  // there is control (no shrinkage towards the input), follows a metre-size
+  // change over tens of metres where the control shows one, and returns to
+  // the input trajectory where no control remains (about tau away).
+  //
+  // Position: sigma and tau of each axis are estimated from the control
+  // (the discrepancies between the matched crossings and the INS
+  // trajectory, by maximum likelihood with the database's own error
+  // removed; error_model.h), within these bounds. With fewer than
+  // min_crossings_for_tau crossings, tau is position_tau_s.
+  bool estimate_position_model = true;
+  double min_position_sigma_m = 0.03;
+  double max_position_sigma_m = 5.0;
+  double position_tau_s = 30.0;
+  int min_crossings_for_tau = 3;
+  // The fast part of the position error (trajectory_jitter.h): when the
+  // trajectory's positions depart from a smooth path over
+  // +-jitter_window_s by more than min_jitter_m (robust RMS, any axis),
+  // each exposure gets its own position offset.
+  double jitter_window_s = 1.5;
+  double min_jitter_m = 0.005;
+  // Attitude: sigma from the trajectory's own sd_roll, sd_pitch and
+  // sd_heading (their median over the samples), at least
+  // min_attitude_sigma_rad; where the data disagree with it beyond their
+  // noise, the variance components widen it (up to max_attitude_sigma_rad).
+  // Control and tie points measure attitude only to a few hundredths of a
+  // degree: a loose attitude prior lets their noise make a good INS worse.
+  double min_attitude_sigma_rad = DegToRad(0.003);
+  double max_attitude_sigma_rad = DegToRad(0.5);
+  double attitude_tau_s = 60.0;
+  // Variance components: after a solve, each soft constraint (vehicle
+  // motion, tie points, the attitude prior) is checked against the data and
+  // its sigma widened where its residuals show more than it states; the
+  // adjustment is then repeated, at most max_variance_iterations times.
+  bool estimate_variance_components = true;
+  int max_variance_iterations = 3;
   // Jumps of the GNSS/INS solution (GNSS coming back after an outage): a
   // sample-to-sample step of the position (attitude) that departs from the
   // motion of the neighbouring samples by more than this. The adjustment
@@ -113,6 +119,15 @@ struct AdjustmentOptions {
   double jump_threshold_deg = 0.05;
 
   // ---------------------------------------------------- control points
+  // Each control vertex is observed as its exposure's stereo pair
+  // reconstructed it (body-frame position and covariance of
+  // reconstructed_bands.csv), the covariance scaled by
+  // stereo_covariance_scale (the reconstruction's is optimistic by about
+  // 2 in sigma on the field cases) with min_stereo_sigma_m added per axis.
+  // With self_calibrate_rig the image positions are used instead (their
+  // reprojection through the corrected mounting), at vertex_sigma_px.
+  double stereo_covariance_scale = 4.0;
+  double min_stereo_sigma_m = 0.005;
   // Sub-pixel band vertices in the images.
   double vertex_sigma_px = 0.5;
   // Huber loss on image residuals, in sigmas.
@@ -134,6 +149,13 @@ struct AdjustmentOptions {
   // crossing as control (the result is not weakened by the check). False:
   // check crossings stay out of the result.
   bool check_points_in_final = true;
+
+  // ---------------------------------------------------- control selection
+  // Before the adjustment, each crossing is tested against the others and
+  // the GNSS/INS error model (control_selection.h): a leave-one-out
+  // chi-square (3 degrees of freedom) above this rejects it, worst first,
+  // until the rest agree (16.27: p = 0.001).
+  double crossing_consistency_chi_square = 16.27;
 
   // ---------------------------------------------------- blunders
   // A control vertex is rejected when its normalised residual (image-only
@@ -167,6 +189,10 @@ struct AdjustmentOptions {
   double sideslip_sigma_deg = 0.1;
   double vertical_slip_sigma_deg = 0.35;
   double vehicle_motion_rate_hz = 10.0;
+  // The sideslip's departures are correlated over about this time (the
+  // body rolling and yawing on its suspension, the driver's steering):
+  // constraints closer than that are not counted as independent.
+  double vehicle_motion_correlation_s = 1.0;
   // Half-length of the chord giving the velocity (at least; the chord
   // joins trajectory samples).
   double vehicle_motion_half_chord_s = 0.05;
@@ -287,10 +313,15 @@ struct AdjustmentSummary {
   double check_database_rms_vertical_m = 0.0;
   double check_implied_trajectory_horizontal_m = 0.0;
   double check_implied_trajectory_vertical_m = 0.0;
+  // The GNSS/INS error model of the final adjustment (estimated or as
+  // configured): per axis along-track, cross-track, up (attitude: about
+  // them), and the vehicle-motion and tie sigmas after variance components.
+  Eigen::Vector3d position_sigma_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d position_tau_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d attitude_sigma_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector2d motion_sigma_rad = Eigen::Vector2d::Zero();
+  double tie_sigma_px = 0.0;
   // Size of the correction applied to the trajectory samples.
-  // GNSS/INS position sigma of the prior (estimated or as configured).
-  double gnss_sigma_horizontal_m = 0.0;
-  double gnss_sigma_vertical_m = 0.0;
   double max_correction_horizontal_m = 0.0;
   double max_correction_vertical_m = 0.0;
   double rms_correction_horizontal_m = 0.0;

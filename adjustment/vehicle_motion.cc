@@ -17,6 +17,42 @@ Eigen::Vector2d CrabAngleResidual(const VehicleMotionSample& sample,
       Eigen::Vector2d(sample.sigma_lateral_rad, sample.sigma_vertical_rad));
 }
 
+Eigen::Vector2d HighFrequencyCrabSpread(
+    const std::vector<VehicleMotionSample>& samples,
+    const TrajectoryCorrection& correction, double window_s) {
+  const int n = static_cast<int>(samples.size());
+  if (n == 0) return Eigen::Vector2d::Zero();
+  const double zero[kVehicleSize] = {0.0, 0.0, 0.0};
+  std::vector<Eigen::Vector2d> crab(n);
+  for (int i = 0; i < n; ++i) {
+    VehicleMotionSample unit = samples[i];
+    unit.sigma_lateral_rad = 1.0;
+    unit.sigma_vertical_rad = 1.0;
+    crab[i] = CrabAngleResidual(unit, correction, zero);
+  }
+  Eigen::Vector2d spread;
+  for (int axis = 0; axis < 2; ++axis) {
+    std::vector<double> departures;
+    int low = 0;
+    int high = 0;
+    for (int i = 0; i < n; ++i) {
+      const double t = samples[i].times[1];
+      while (samples[low].times[1] < t - window_s) ++low;
+      while (high < n && samples[high].times[1] <= t + window_s) ++high;
+      std::vector<double> window;
+      for (int j = low; j < high; ++j) window.push_back(crab[j][axis]);
+      std::nth_element(window.begin(), window.begin() + window.size() / 2,
+                       window.end());
+      departures.push_back(std::abs(crab[i][axis] - window[window.size() / 2]));
+    }
+    std::nth_element(departures.begin(),
+                     departures.begin() + departures.size() / 2,
+                     departures.end());
+    spread[axis] = 1.4826 * departures[departures.size() / 2];
+  }
+  return spread;
+}
+
 VehicleMotionCost* VehicleMotionCost::Create(
     const VehicleMotionSample& sample, const TrajectoryCorrection& correction) {
   return new VehicleMotionCost(sample, correction);

@@ -68,7 +68,8 @@ Eigen::Vector2d CrabAngleResidual(const VehicleMotionSample& sample,
 // Constraints about every 1 / rate_hz over the trajectory where the INS
 // speed is at least min_speed_mps. The chord joins two trajectory samples
 // (interpolating positions between samples would bend it on a turn) at
-// least 2 * min_half_chord_s apart; t is their mid-time. `sample_times`
+// least 2 * min_half_chord_s apart, with no gap of the trajectory between
+// them; t is their mid-time. `sample_times`
 // are the trajectory's, increasing; `ins_pose_at` gives the (jump-free)
 // INS pose, false outside the trajectory.
 template <typename PoseAt>
@@ -77,6 +78,17 @@ std::vector<VehicleMotionSample> MakeVehicleMotionSamples(
     const std::vector<double>& sample_times, double rate_hz,
     double min_half_chord_s, double min_speed_mps,
     const Eigen::Vector2d& sigma_rad, PoseAt&& ins_pose_at);
+
+// The high-frequency spread (lateral, vertical; radians) of the crab
+// angles of `samples` under `correction` (zero vehicle block): each angle
+// minus the median of those within +-window_s, robust RMS of that. A
+// trajectory whose positions jitter from sample to sample (an unsmoothed
+// GNSS solution) has a direction of travel that departs from its heading
+// by degrees over a short chord; no smooth correction removes that, so it
+// is the constraint's noise, not the vehicle's sideslip.
+Eigen::Vector2d HighFrequencyCrabSpread(
+    const std::vector<VehicleMotionSample>& samples,
+    const TrajectoryCorrection& correction, double window_s);
 
 // The residual as a function of the corrections c at t - h, t, t + h (6
 // each) and the vehicle block.
@@ -162,6 +174,14 @@ std::vector<VehicleMotionSample> MakeVehicleMotionSamples(
   if (!(rate_hz > 0.0) || n < 3) return samples;
   // Times are compared to a microsecond (sample times in a file are rounded).
   constexpr double kTolerance = 1e-6;
+  // gaps_up_to[k]: gaps of the trajectory (survey/trajectory.h) among the
+  // intervals before sample k. A chord across a gap is not the vehicle's
+  // direction of travel (on a turn it cuts the corner).
+  std::vector<int> gaps_up_to(n, 0);
+  for (const TrajectoryGap& gap : FindTrajectoryGaps(sample_times)) {
+    ++gaps_up_to[gap.before + 1];
+  }
+  for (int k = 1; k < n; ++k) gaps_up_to[k] += gaps_up_to[k - 1];
   double next = sample_times.front();
   for (int i = 0; i < n; ++i) {
     if (sample_times[i] < next - kTolerance) continue;
@@ -170,6 +190,7 @@ std::vector<VehicleMotionSample> MakeVehicleMotionSamples(
         std::lower_bound(sample_times.begin() + i, sample_times.end(),
                          sample_times[i] + 2.0 * min_half_chord_s - kTolerance);
     if (j == sample_times.end()) break;
+    if (gaps_up_to[j - sample_times.begin()] > gaps_up_to[i]) continue;
     VehicleMotionSample s;
     s.times = {sample_times[i], 0.5 * (sample_times[i] + *j), *j};
     s.sigma_lateral_rad = sigma_rad.x();

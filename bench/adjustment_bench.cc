@@ -174,16 +174,17 @@ int ScoreSurvey(const std::string& survey_folder,
     const char* name;
     AdjustmentOptions options;
   };
-  AdjustmentOptions first;
-  first.estimate_gnss_sigma = false;
-  first.prior_correlation_time_s = first.knot_spacing_s;
-  first.check_points_in_final = false;
-  const std::vector<Model> models = {{"first model", first},
+  // The GNSS/INS error model as configured (1 m, 30 s), against the one
+  // estimated from the control and the trajectory.
+  AdjustmentOptions fixed;
+  fixed.estimate_position_model = false;
+  fixed.estimate_variance_components = false;
+  const std::vector<Model> models = {{"fixed model", fixed},
                                      {"current", AdjustmentOptions()}};
   std::printf("%s: %zu tie tracks\n", survey_folder.c_str(), tracks.size());
   std::printf("%-12s | %-22s | %-22s | %-22s | %s\n", "model",
               "all H/V cm, att deg", "between control", "beyond control",
-              "check RMSE H/V cm, prior sigma H/V m, rejected");
+              "check RMSE H/V cm, process sigma along/cross/up m, rejected");
   bool printed_before = false;
   for (Model model : models) {
     model.options.solver.num_threads = threads;
@@ -238,12 +239,12 @@ int ScoreSurvey(const std::string& survey_folder,
     const AdjustmentSummary& s = result.summary;
     std::printf(
         "%-12s | %6.1f %6.1f %7.3f | %6.1f %6.1f %7.3f | %6.1f %6.1f "
-        "%7.3f | %5.1f %5.1f, %5.2f %5.2f, %d\n",
+        "%7.3f | %5.1f %5.1f, %5.2f %5.2f %5.2f, %d\n",
         model.name, 100 * e.all.h, 100 * e.all.v, e.all.att, 100 * e.inside.h,
         100 * e.inside.v, e.inside.att, 100 * e.outside.h, 100 * e.outside.v,
         e.outside.att, 100 * s.check_rmse_horizontal_m,
-        100 * s.check_rmse_vertical_m, s.gnss_sigma_horizontal_m,
-        s.gnss_sigma_vertical_m, s.num_rejected_points);
+        100 * s.check_rmse_vertical_m, s.position_sigma_m.x(),
+        s.position_sigma_m.y(), s.position_sigma_m.z(), s.num_rejected_points);
     std::fflush(stdout);
   }
   return 0;

@@ -624,6 +624,8 @@ ReconstructionSummary ReconstructSurvey(
     const ExposureResult& r = results[e];
     if (r.skipped) {
       ++summary.exposures_skipped;
+      summary.skipped_exposures.emplace_back(exposures[e].exposure_id,
+                                             r.warning);
       summary.warnings.push_back(r.warning);
       LOG(WARNING) << r.warning;
       continue;

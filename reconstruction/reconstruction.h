@@ -32,6 +32,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "reconstruction/band_modeling.h"
@@ -171,6 +172,8 @@ struct ReconstructionSummary {
   int exposures = 0;            // in the survey
   int exposures_processed = 0;  // all their pairs ran
   int exposures_skipped = 0;    // unreadable or missing images
+  // Their ids and why, in time order (their warnings say the same).
+  std::vector<std::pair<int64_t, std::string>> skipped_exposures;
   int pairs_processed = 0;
   int pairs_without_road = 0;  // no road plane found
   int bands = 0;

@@ -19,6 +19,9 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDuplicateHypothesisM = 0.1;
 // Observations of one crossing further apart in time start a new pass.
 constexpr double kPassGapFactor = 2.0;
+// Evidence counts as strong only from a view whose own best hypothesis lies
+// within this of the correction scored (see WindowEvidence).
+constexpr double kStrongAgreementM = 0.1;
 // A non-explained band this close (across) to a database band's centre
 // line is that band seen partly (truncated, occluded): no evidence either way.
 constexpr double kPartialBandAcrossM = 0.25;
@@ -132,7 +135,12 @@ struct Eval {
   std::vector<int> missing;         // database bands
   std::vector<int> contradictions;  // observed bands
   std::vector<int> unexplained;     // observed bands
-  std::vector<int> partial;         // observed bands
+  // The unexplained bands lying beyond the crossing's band 1 (held or
+  // implied): the database's numbering says the crossing ends there, so a
+  // hypothesis that leaves a band there is contradicted, not merely short
+  // of a band the database may have lost at its far end.
+  std::vector<int> beyond_first;
+  std::vector<int> partial;  // observed bands
   double score = 0.0;
 
   // The crossing most hits fall on, or -1.
@@ -242,6 +250,10 @@ class Matcher {
   void PrepareObservations();
   // Stage 1.
   Eval Evaluate(const Obs& obs, const PoseCorrection& c) const;
+  // Whether a band centred at `centre` lies one or two periods beyond the
+  // crossing's band 1 (held or implied by the numbering).
+  bool BeyondBandOne(const IndexedCrossing& crossing,
+                     const Eigen::Vector2d& centre) const;
   void ClassifyUnexplained(const Eigen::Vector2d& centre, int rec,
                            Eval* eval) const;
   PoseCorrection Refine(const Obs& obs, const Eval& eval,
@@ -297,9 +309,18 @@ class Matcher {
   // the hits and unexplained bands of the view's own hypothesis at `c`,
   // plus the missing database bands counted per band (see the .cc). With
   // `units`, the evidence by crossing end (bands placed with `placement`).
+  // Evidence of one crossing end (or of nothing, unit -1): `strong` is
+  // what neither a database missing an end band nor an end band hidden in
+  // the images can fake (bare road where paint is predicted, a band in a
+  // gap of the crossing or beyond its band 1); `weak` is the rest (bands
+  // explained, bands beyond the crossing's last band).
+  struct Evidence {
+    double weak = 0.0;
+    double strong = 0.0;
+  };
   double WindowEvidence(int o, const PoseCorrection& c,
                         const PoseCorrection& placement,
-                        std::map<int, double>* units) const;
+                        std::map<int, Evidence>* units) const;
   int EndUnit(const Eigen::Vector2d& p_enu) const;
   // The best-scoring hypothesis of observation `other` within the window
   // tolerance of `c`, or null.
@@ -311,6 +332,7 @@ class Matcher {
   struct Margin {
     double raw = 0.0;        // aggregated score difference
     double both_ends = 0.0;  // without the evidence of the stronger end
+    double strong = 0.0;     // of the strong evidence alone
   };
   Margin MarginOver(int o, const Hypothesis& best,
                     const Hypothesis& other) const;
@@ -454,9 +476,29 @@ void Matcher::ClassifyUnexplained(const Eigen::Vector2d& centre, int rec,
   }
   if (contradiction) {
     eval->contradictions.push_back(rec);
-  } else {
-    eval->unexplained.push_back(rec);
+    return;
   }
+  eval->unexplained.push_back(rec);
+  for (int c : crossings) {
+    if (BeyondBandOne(index_.crossings()[c], centre)) {
+      eval->beyond_first.push_back(rec);
+      break;
+    }
+  }
+}
+
+bool Matcher::BeyondBandOne(const IndexedCrossing& crossing,
+                            const Eigen::Vector2d& centre) const {
+  // Band numbers grow along across_axis; band 1 lies first_band - 1
+  // periods before the first held band.
+  const Eigen::Vector2d p = crossing.ToCrossing(centre);
+  const Eigen::Vector2d first = crossing.ToCrossing(crossing.first_end_enu);
+  const double s = crossing.spacing_m;
+  const double y1 = first.y() - (crossing.first_band - 1) * s;
+  const double along =
+      p.x() - first.x() - std::tan(crossing.skew_rad) * (p.y() - first.y());
+  return p.y() < y1 - 0.5 * s && p.y() > y1 - 2.5 * s &&
+         std::abs(along) < 0.5 * crossing.band_length_m + 0.5;
 }
 
 Eval Matcher::Evaluate(const Obs& obs, const PoseCorrection& c) const {
@@ -525,7 +567,11 @@ Eval Matcher::Evaluate(const Obs& obs, const PoseCorrection& c) const {
         seen.push_back(index_.bands()[h.db].corners_enu);
     }
     for (int crossing : crossings) {
-      for (int b : index_.crossings()[crossing].bands) {
+      std::vector<int> predicted = index_.crossings()[crossing].bands;
+      const std::vector<int>& implied =
+          index_.crossings()[crossing].implied_bands;
+      predicted.insert(predicted.end(), implied.begin(), implied.end());
+      for (int b : predicted) {
         if (used_db.count(b)) continue;
         if (!visibility_.BandVisible(pose, index_.bands()[b])) continue;
         // A band the reconstruction missed (hidden, worn, lost at range) is
@@ -552,8 +598,13 @@ PoseCorrection Matcher::Refine(const Obs& obs, const Eval& eval,
   if (eval.hits.empty()) return start;
   std::vector<Eigen::Vector2d> a;
   std::vector<Eigen::Vector2d> b;
+  // Implied bands' corners are extrapolated: fitted on only when fewer
+  // than two held bands are hit.
+  int held = 0;
+  for (const Hit& h : eval.hits) held += index_.bands()[h.db].implied ? 0 : 1;
   for (const Hit& h : eval.hits) {
     const IndexedBand& db = index_.bands()[h.db];
+    if (db.implied && held >= 2) continue;
     for (int k = 0; k < 4; ++k) {
       a.push_back(obs.bands[h.rec].q[k]);
       b.push_back(db.corners_enu[PermutedCorner(h.perm, k)].head<2>() -
@@ -684,46 +735,80 @@ void Matcher::Aggregate() {
 
 double Matcher::WindowEvidence(int o, const PoseCorrection& c,
                                const PoseCorrection& placement,
-                               std::map<int, double>* units) const {
+                               std::map<int, Evidence>* units) const {
   const double t = input_.observations[o].time_s;
-  std::map<int, double> local;
-  std::map<int, double>& by_unit = units != nullptr ? *units : local;
+  std::map<int, Evidence> local;
+  std::map<int, Evidence>& by_unit = units != nullptr ? *units : local;
   std::set<int> seen;                // database bands hit in the window
   std::map<int, int> missing_views;  // database band -> views missing it
+  // Contradictions are strong only when two views show them: one view's
+  // odd band (a reflection, a band of another crossing) must not decide.
+  std::map<int, std::set<int>> contradicting_views;
+  std::map<int, double> contradiction_strong;
   for (int m = window_[o].first; m < window_[o].second; ++m) {
     const int q = by_time_[m];
     const Hypothesis* g = Supporting(q, c, input_.observations[q].time_s - t);
     if (g == nullptr) continue;  // no band of q fits c: no information
     const Obs& obs = obs_[q];
+    // Evidence is strong only from a view whose own fit is this
+    // correction: a view's best hypothesis merely within the window's
+    // tolerance places its bands up to decimetres off, between the
+    // database's bands, where they would read as contradictions.
+    const bool agrees = CorrectionDistance(g->correction, c, obs.centroid_q) <=
+                        kStrongAgreementM;
     auto unit_of = [&](int rec) {
       return units == nullptr ? -1
                               : EndUnit(Apply(placement, obs.vehicle,
                                               obs.bands[rec].shape.centre));
     };
     for (const Hit& hit : g->eval.hits) {
-      by_unit[unit_of(hit.rec)] += 1.0;
+      by_unit[unit_of(hit.rec)].weak += 1.0;
       seen.insert(hit.db);
     }
+    // A band cut short (an occluder, the image border) is not a band of
+    // its own where it lies: strong evidence takes whole bands only.
+    auto whole = [&](int rec) {
+      return g->main_crossing >= 0 &&
+             std::abs(obs.bands[rec].shape.length_m -
+                      index_.crossings()[g->main_crossing].band_length_m) <=
+                 options_.max_length_difference_m;
+    };
+    const std::set<int> beyond_first(g->eval.beyond_first.begin(),
+                                     g->eval.beyond_first.end());
     for (int rec : g->eval.unexplained) {
-      by_unit[unit_of(rec)] -= options_.unexplained_band_weight;
+      Evidence& e = by_unit[unit_of(rec)];
+      (agrees && whole(rec) && beyond_first.count(rec) ? e.strong : e.weak) -=
+          options_.unexplained_band_weight;
     }
     for (int rec : g->eval.contradictions) {
-      by_unit[unit_of(rec)] -= options_.contradiction_weight;
+      const int unit = unit_of(rec);
+      if (agrees && whole(rec)) {
+        contradicting_views[unit].insert(q);
+        contradiction_strong[unit] += options_.contradiction_weight;
+      } else {
+        by_unit[unit].weak -= options_.contradiction_weight;
+      }
     }
-    for (int b : g->eval.missing) ++missing_views[b];
+    if (agrees) {
+      for (int b : g->eval.missing) ++missing_views[b];
+    }
   }
   // A database band missed in some views but seen in another was hidden
   // (a parked vehicle) or missed by the detector: no evidence. One never
   // seen counts for at most max_missing_views views: views of one place are
   // not independent (an occluder hides it from every one of them).
+  for (const auto& [unit, amount] : contradiction_strong) {
+    Evidence& e = by_unit[unit];
+    (contradicting_views[unit].size() >= 2 ? e.strong : e.weak) -= amount;
+  }
   for (const auto& [b, views] : missing_views) {
     if (seen.count(b)) continue;
-    by_unit[units == nullptr ? -1 : EndUnit(index_.bands()[b].centre_enu)] -=
-        options_.missing_band_weight *
-        std::min(views, options_.max_missing_views);
+    by_unit[units == nullptr ? -1 : EndUnit(index_.bands()[b].centre_enu)]
+        .strong -= options_.missing_band_weight *
+                   std::min(views, options_.max_missing_views);
   }
   double total = 0.0;
-  for (const auto& [unit, value] : by_unit) total += value;
+  for (const auto& [unit, value] : by_unit) total += value.weak + value.strong;
   return total;
 }
 
@@ -759,21 +844,30 @@ Matcher::Margin Matcher::MarginOver(int o, const Hypothesis& best,
                                     const Hypothesis& other) const {
   // Both attributed with the best's placement, so that a band counts at the
   // same end under both hypotheses.
-  std::map<int, double> mine;
-  std::map<int, double> theirs;
+  std::map<int, Evidence> mine;
+  std::map<int, Evidence> theirs;
   const double total =
       WindowEvidence(o, best.correction, best.correction, &mine) -
       WindowEvidence(o, other.correction, best.correction, &theirs);
-  std::map<int, double> delta = mine;
-  for (const auto& [unit, value] : theirs) delta[unit] -= value;
+  std::map<int, double> delta;
+  double strong = 0.0;
+  for (const auto& [unit, value] : mine) {
+    delta[unit] += value.weak + value.strong;
+    strong += value.strong;
+  }
+  for (const auto& [unit, value] : theirs) {
+    delta[unit] -= value.weak + value.strong;
+    strong -= value.strong;
+  }
   double discount = 0.0;
   for (const auto& [unit, value] : delta) {
     if (unit >= 0) discount = std::max(discount, value);
   }
   VLOG(2) << "margin of observation " << o << " (exposure "
           << input_.observations[o].exposure_id << "): " << total
-          << ", both ends " << total - discount;
-  return {total, total - discount};
+          << ", both ends " << total - discount << ", strong " << strong
+          << " against " << DescribeAlternative(obs_[o], best, other);
+  return {total, total - discount, strong};
 }
 
 std::string Matcher::DescribeAlternative(const Obs& obs, const Hypothesis& best,
@@ -858,6 +952,12 @@ void Matcher::DecideAlone(int o) {
   int runner = -1;
   double margin = std::numeric_limits<double>::infinity();
   double both_ends = std::numeric_limits<double>::infinity();
+  // An alternative beaten at one end only, and there only by band counts
+  // (bands explained, a band beyond the crossing's last one): a database
+  // missing that end band, or an end band hidden in the images, would give
+  // the same counts. Its strong margin, and which it is.
+  double one_end_strong = std::numeric_limits<double>::infinity();
+  int one_end_runner = -1;
   for (size_t k = 0; k < list.size(); ++k) {
     if (static_cast<int>(k) == best) continue;
     if (CorrectionDistance(list[k].correction, h.correction, obs.centroid_q) <
@@ -871,6 +971,10 @@ void Matcher::DecideAlone(int o) {
     }
     margin = std::min(margin, m.raw);
     both_ends = std::min(both_ends, m.both_ends);
+    if (m.both_ends < options_.min_margin && m.strong < one_end_strong) {
+      one_end_strong = m.strong;
+      one_end_runner = static_cast<int>(k);
+    }
   }
   if (runner >= 0) {
     const Hypothesis& r = list[runner];
@@ -913,6 +1017,17 @@ void Matcher::DecideAlone(int o) {
     }
     return;
   }
+  if (one_end_runner >= 0 && one_end_strong < options_.min_strong_margin) {
+    ambiguous_[o] = true;
+    ev.reason = "ambiguous: decided against " +
+                DescribeAlternative(obs, h, list[one_end_runner]) +
+                " by the band count at one end of the crossing alone "
+                "(evidence a database missing that end band, or an end band "
+                "hidden in the images, cannot fake: " +
+                Fixed(std::max(0.0, one_end_strong), 2) + " < " +
+                Fixed(options_.min_strong_margin, 1) + ")";
+    return;
+  }
   accepted_[o] = true;
   ev.decision = Decision::kMatched;
   std::ostringstream reason;
@@ -922,9 +1037,11 @@ void Matcher::DecideAlone(int o) {
   if (runner >= 0) {
     reason << "; next " << ev.runner_up << " " << Fixed(ev.runner_up_score, 1);
     if (both_ends < options_.min_margin) {
-      // Said plainly: a database fault at that end (a band missing on one
-      // side) would make this a one-band error; continuity checks it.
-      reason << "; decided by one end of the crossing";
+      // Said plainly: decided at one end, by what a database fault there
+      // cannot fake (bare road where the alternative puts paint, a band
+      // beyond band 1).
+      reason << "; decided at one end of the crossing, by what the images "
+                "show there";
     }
   } else {
     reason << "; no alternative";
@@ -1287,6 +1404,7 @@ void Matcher::EmitMatches(int o) {
   std::vector<VertexMatch> out;
   for (const Hit& hit : eval.hits) {
     const IndexedBand& db = index_.bands()[hit.db];
+    if (db.implied) continue;  // no database coordinates to control with
     const ObsBand& band = obs.bands[hit.rec];
     std::array<double, 4> error;
     bool fits = true;
@@ -1343,7 +1461,9 @@ void Matcher::DetectFaults() {
       ++band_seen[hit.db];
       matched_crossings.insert(index_.bands()[hit.db].crossing);
     }
-    for (int b : h.eval.missing) band_missing[b].push_back(exposure);
+    for (int b : h.eval.missing) {
+      if (!index_.bands()[b].implied) band_missing[b].push_back(exposure);
+    }
     if (h.main_crossing < 0) continue;
     const IndexedCrossing& crossing = crossings[h.main_crossing];
     const Eigen::Vector2d first = crossing.ToCrossing(crossing.first_end_enu);
@@ -1668,6 +1788,7 @@ std::string MatchOptions::Check() const {
       !positive("same_correction_tolerance_m", same_correction_tolerance_m) ||
       !non_negative("drift_rate_m_per_s", drift_rate_m_per_s) ||
       !positive("min_margin", min_margin) ||
+      !non_negative("min_strong_margin", min_strong_margin) ||
       !non_negative("neighbour_window_s", neighbour_window_s) ||
       !positive("neighbour_tolerance_m", neighbour_tolerance_m) ||
       !non_negative("max_drift_rate_m_per_s", max_drift_rate_m_per_s) ||

@@ -103,6 +103,54 @@ IndexedCrossing CrossingGeometry(const std::string& crossing_id,
   return crossing;
 }
 
+// The bands `crossing`'s numbering implies but the database lacks
+// (IndexedBand::implied), appended to `bands` and `values`.
+void AddImpliedBands(int index, IndexedCrossing* crossing,
+                     std::vector<IndexedBand>* bands,
+                     std::vector<TreeValue>* values) {
+  const IndexedBand& first = (*bands)[crossing->bands.front()];
+  const IndexedBand& last = (*bands)[crossing->bands.back()];
+  const int numbers = last.band - first.band;
+  if (numbers <= 0) return;  // one band: no period to extrapolate with
+  // One band number further, centre to centre (skew included).
+  const Eigen::Vector2d period =
+      (last.centre_enu - first.centre_enu) / static_cast<double>(numbers);
+  std::vector<int> missing = crossing->missing_band_numbers;
+  for (int n = 1; n < first.band; ++n) missing.push_back(n);
+  std::sort(missing.begin(), missing.end());
+  for (int n : missing) {
+    // The held band nearest in number lends its shape.
+    int nearest = crossing->bands.front();
+    for (int b : crossing->bands) {
+      if (std::abs((*bands)[b].band - n) <
+          std::abs((*bands)[nearest].band - n)) {
+        nearest = b;
+      }
+    }
+    IndexedBand band = (*bands)[nearest];
+    const Eigen::Vector2d shift = (n - band.band) * period;
+    band.source_index = -1;
+    band.band = n;
+    band.implied = true;
+    Eigen::Vector2d low =
+        Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector2d high = -low;
+    for (Eigen::Vector3d& corner : band.corners_enu) {
+      corner.head<2>() += shift;
+      low = low.cwiseMin(corner.head<2>());
+      high = high.cwiseMax(corner.head<2>());
+    }
+    band.centre_enu += shift;
+    band.crossing = index;
+    const int id = static_cast<int>(bands->size());
+    crossing->implied_bands.push_back(id);
+    values->emplace_back(
+        BoostBox(BoostPoint(low.x(), low.y()), BoostPoint(high.x(), high.y())),
+        id);
+    bands->push_back(std::move(band));
+  }
+}
+
 }  // namespace
 
 Eigen::Vector2d IndexedCrossing::ToCrossing(
@@ -135,6 +183,7 @@ BandShape ShapeOfBand(const std::array<Eigen::Vector2d, 4>& c) {
 }
 
 struct RoadmarkIndex::Impl {
+  int num_database_bands = 0;
   std::vector<IndexedBand> bands;
   std::vector<IndexedCrossing> crossings;
   std::unordered_map<std::string, int> crossing_of_id;
@@ -196,9 +245,17 @@ RoadmarkIndex::RoadmarkIndex(const RoadmarkDatabase& database,
     const std::string& id = bands[members[c].front()].crossing_id;
     impl_->crossings.push_back(CrossingGeometry(id, members[c], bands));
   }
+  impl_->num_database_bands = static_cast<int>(bands.size());
+  for (size_t c = 0; c < impl_->crossings.size(); ++c) {
+    AddImpliedBands(static_cast<int>(c), &impl_->crossings[c], &bands, &values);
+  }
   impl_->tree = Tree(values.begin(), values.end());
   VLOG(1) << "road-mark index: " << bands.size() << " bands, "
           << impl_->crossings.size() << " crossings";
+}
+
+int RoadmarkIndex::num_database_bands() const {
+  return impl_->num_database_bands;
 }
 
 const std::vector<IndexedBand>& RoadmarkIndex::bands() const {

@@ -41,6 +41,13 @@ struct IndexedBand {
   double width_m = 0.0;   // area / length (perpendicular width)
   double sigma_xy_m = 0.0;
   double sigma_z_m = 0.0;
+  // A band the database's own numbering says exists but that it does not
+  // hold (a crossing numbered from 3 has bands 1 and 2 in the street; one
+  // numbered 1, 2, 4 lacks band 3): its corners extrapolated from the
+  // nearest held band by the crossing's period. Never a control point
+  // (source_index -1), but a hypothesis that puts paint there must find
+  // paint there, and an observed band there is explained.
+  bool implied = false;
 };
 
 struct IndexedCrossing {
@@ -58,6 +65,10 @@ struct IndexedCrossing {
   // Band numbers absent between first_band and last_band (the database
   // lost them, or the crossing has a gap).
   std::vector<int> missing_band_numbers;
+  // The implied bands (indices in RoadmarkIndex::bands()): numbers 1 ..
+  // first_band - 1 and missing_band_numbers, where the period is known
+  // (at least two held bands).
+  std::vector<int> implied_bands;
   // Centres of the first and last bands: the crossing's ends.
   Eigen::Vector2d first_end_enu = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_end_enu = Eigen::Vector2d::Zero();
@@ -81,7 +92,10 @@ class RoadmarkIndex {
   RoadmarkIndex(RoadmarkIndex&&) noexcept;
   RoadmarkIndex& operator=(RoadmarkIndex&&) noexcept;
 
+  // The database's bands first (num_database_bands() of them, in the
+  // database's order), then the implied ones.
   const std::vector<IndexedBand>& bands() const;
+  int num_database_bands() const;
   const std::vector<IndexedCrossing>& crossings() const;
   // Index of the crossing named `crossing_id`, or -1.
   int FindCrossing(const std::string& crossing_id) const;

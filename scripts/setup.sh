@@ -8,6 +8,7 @@ PACKAGES=(
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libopencv-contrib-dev libgeographiclib-dev
   libyaml-cpp-dev nlohmann-json3-dev libsimdjson-dev libcli11-dev libbz2-dev
+  libpng-dev libtiff-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev
   python3 python3-numpy python3-opencv python3-yaml

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
 
@@ -10,6 +11,13 @@ namespace zebrageo {
 namespace {
 
 constexpr char kTempMarker[] = ".tmp-";
+
+// The fault-injection seam of atomic_file.h.
+bool InjectedWriteFailure(const std::string& path) {
+  const char* name = std::getenv("ZEBRAGEO_FAIL_WRITE");
+  return name != nullptr && *name != '\0' &&
+         std::filesystem::path(path).filename() == name;
+}
 
 }  // namespace
 
@@ -31,7 +39,7 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::Commit() {
   out_.flush();
-  const bool written = static_cast<bool>(out_);
+  const bool written = static_cast<bool>(out_) && !InjectedWriteFailure(path_);
   out_.close();
   if (!written || out_.fail()) {
     std::remove(temp_path_.c_str());

@@ -5,6 +5,12 @@
 // reader (or a rerun after a kill) sees either the old file, the complete new
 // one, or none. If Commit() is never reached (an exception, a crash handled
 // by the destructor), the temporary file is removed.
+//
+// Fault injection, for tests only: when the environment variable
+// ZEBRAGEO_FAIL_WRITE names a file (its name without folder, e.g.
+// "poses.csv"), Commit() of that file fails as on a full disk. A tmpfs
+// filled to the brim would need root; this seam shows what every command
+// leaves behind when the disk fills up at a given file.
 #ifndef ZEBRAGEO_SURVEY_ATOMIC_FILE_H_
 #define ZEBRAGEO_SURVEY_ATOMIC_FILE_H_
 

@@ -29,6 +29,10 @@ std::vector<std::string> SplitFields(const std::string& line) {
   return fields;
 }
 
+bool HasUtf8ByteOrderMark(const std::string& text) {
+  return text.compare(0, 3, "\xEF\xBB\xBF") == 0;
+}
+
 bool IsSkipped(const std::string& line) {
   const std::string trimmed = Trim(line);
   return trimmed.empty() || trimmed[0] == '#';
@@ -63,7 +67,9 @@ CsvTable CsvTable::Parse(const std::string& text,
   if (text.find('\0') != std::string::npos) {
     throw InputError(display_name, 0, "binary data (NUL byte): not a CSV file");
   }
-  std::istringstream in(text);
+  // Spreadsheet exports start UTF-8 files with a byte-order mark; the
+  // contract allows it and it is not part of the first column's name.
+  std::istringstream in(HasUtf8ByteOrderMark(text) ? text.substr(3) : text);
   std::string line;
   int line_number = 0;
   bool have_header = false;

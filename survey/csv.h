@@ -1,9 +1,11 @@
 // The one CSV reader and writer of the project.
 //
-// Reading: lines starting with '#' (after optional spaces) and blank lines are
-// skipped; the first other line is the header. Columns are found by name, so
-// extra columns are allowed and ignored. Every accessor that fails throws
-// InputError with the file, the line number in the file and the column, e.g.
+// Reading: a leading UTF-8 byte-order mark is ignored (spreadsheet exports
+// write one; SURVEY_FORMAT.md allows it); lines starting with '#' (after
+// optional spaces) and blank lines are skipped; the first other line is the
+// header. Columns are found by name, so extra columns are allowed and ignored.
+// Every accessor that fails throws InputError with the file, the line number in
+// the file and the column, e.g.
 //   trajectory.csv:213: column 'heading': "abc" is not a number
 // Fields are split on ',' and trimmed; quoting is not used by the survey
 // format and a '"' in a field is rejected.

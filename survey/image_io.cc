@@ -1,12 +1,128 @@
 #include "survey/image_io.h"
 
+#include <png.h>
+#include <tiffio.h>
+
+#include <csetjmp>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "survey/input_error.h"
 
 namespace zebrageo {
+namespace {
+
+// libtiff's own allocations while reading a header (its directory): a
+// crafted file cannot make it take more.
+constexpr tmsize_t kMaxTiffHeaderAllocation = 16 << 20;
+
+bool StartsWith(const char* bytes, size_t size, const char* prefix,
+                size_t prefix_size) {
+  return size >= prefix_size &&
+         std::char_traits<char>::compare(bytes, prefix, prefix_size) == 0;
+}
+
+// libpng reports errors by longjmp: this function keeps only trivially
+// destructible locals between setjmp and the libpng calls, as longjmp skips
+// destructors. Returns false on a corrupt header.
+bool ReadPngSize(FILE* file, png_uint_32* width, png_uint_32* height) {
+  png_structp png = png_create_read_struct(
+      PNG_LIBPNG_VER_STRING, nullptr,
+      [](png_structp p, png_const_charp) { png_longjmp(p, 1); },
+      [](png_structp, png_const_charp) {});
+  if (png == nullptr) return false;
+  png_infop info = png_create_info_struct(png);
+  if (info == nullptr || setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return false;
+  }
+  png_set_chunk_malloc_max(png, 8 << 20);  // text or profile chunks
+  png_init_io(png, file);
+  png_read_info(png, info);  // the chunks before the image data, no pixel
+  *width = png_get_image_width(png, info);
+  *height = png_get_image_height(png, info);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return true;
+}
+
+ImageHeader PngHeader(const std::string& path,
+                      const std::string& display_name) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                             &std::fclose);
+  if (!file) throw InputError(display_name, 0, "cannot open image file");
+  png_uint_32 width = 0, height = 0;
+  if (!ReadPngSize(file.get(), &width, &height) || width == 0 || height == 0 ||
+      width > 1000000 || height > 1000000) {
+    throw InputError(display_name, 0,
+                     "cannot decode image: corrupt PNG header");
+  }
+  ImageHeader header;
+  header.format = ImageHeader::Format::kPng;
+  header.width = static_cast<int>(width);
+  header.height = static_cast<int>(height);
+  return header;
+}
+
+ImageHeader TiffHeader(const std::string& path,
+                       const std::string& display_name) {
+  // Errors stay quiet (libtiff would print them): the InputError says it.
+  auto quiet = [](TIFF*, void*, const char*, const char*, va_list) {
+    return 1;
+  };
+  std::unique_ptr<TIFFOpenOptions, void (*)(TIFFOpenOptions*)> options(
+      TIFFOpenOptionsAlloc(), &TIFFOpenOptionsFree);
+  TIFFOpenOptionsSetErrorHandlerExtR(options.get(), quiet, nullptr);
+  TIFFOpenOptionsSetWarningHandlerExtR(options.get(), quiet, nullptr);
+  TIFFOpenOptionsSetMaxSingleMemAlloc(options.get(), kMaxTiffHeaderAllocation);
+  // "rm": read the first directory only, without mapping the file.
+  std::unique_ptr<TIFF, void (*)(TIFF*)> tiff(
+      TIFFOpenExt(path.c_str(), "rm", options.get()), &TIFFClose);
+  uint32_t width = 0, height = 0;
+  if (!tiff || !TIFFGetField(tiff.get(), TIFFTAG_IMAGEWIDTH, &width) ||
+      !TIFFGetField(tiff.get(), TIFFTAG_IMAGELENGTH, &height) || width == 0 ||
+      height == 0 || width > 1000000 || height > 1000000) {
+    throw InputError(display_name, 0,
+                     "cannot decode image: corrupt TIFF header");
+  }
+  ImageHeader header;
+  header.format = ImageHeader::Format::kTiff;
+  header.width = static_cast<int>(width);
+  header.height = static_cast<int>(height);
+  return header;
+}
+
+std::string SizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+}  // namespace
+
+ImageHeader ReadImageHeader(const std::string& path,
+                            const std::string& display_name) {
+  char magic[8] = {};
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(display_name, 0, "cannot open image file");
+    in.read(magic, sizeof(magic));
+  }
+  const size_t size = sizeof(magic);
+  if (StartsWith(magic, size, "\x89PNG\r\n\x1a\n", 8)) {
+    return PngHeader(path, display_name);
+  }
+  // Little- and big-endian TIFF, and BigTIFF.
+  if (StartsWith(magic, size, "II*\0", 4) ||
+      StartsWith(magic, size, "MM\0*", 4) ||
+      StartsWith(magic, size, "II+\0", 4) ||
+      StartsWith(magic, size, "MM\0+", 4)) {
+    return TiffHeader(path, display_name);
+  }
+  throw InputError(display_name, 0,
+                   "cannot decode image (not a PNG or TIFF file)");
+}
 
 cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
                       int expected_width, int expected_height) {
@@ -17,6 +133,22 @@ cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
   if (!std::filesystem::is_regular_file(path, error)) {
     throw InputError(display_name, 0, "image path is not a file");
   }
+  const ImageHeader header = ReadImageHeader(path, display_name);
+  if (header.pixels() > kMaxImagePixels) {
+    throw InputError(display_name, 0,
+                     "image is " + SizeText(header.width, header.height) +
+                         " pixels, more than the limit of " +
+                         std::to_string(kMaxImagePixels / 1000000) +
+                         " megapixels (from its header; not decoded)");
+  }
+  if (expected_width > 0 &&
+      (header.width != expected_width || header.height != expected_height)) {
+    throw InputError(display_name, 0,
+                     "image is " + SizeText(header.width, header.height) +
+                         " pixels but the rig's camera is " +
+                         SizeText(expected_width, expected_height) +
+                         " (from its header; not decoded)");
+  }
   cv::Mat raw;
   try {
     // ANYDEPTH keeps 16-bit images 16-bit (the default would cut them to 8).
@@ -25,7 +157,12 @@ cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
     raw.release();  // some decoders throw on corrupt data instead of failing
   }
   if (raw.empty()) {
-    throw InputError(display_name, 0, "cannot decode image (not a PNG/TIFF?)");
+    throw InputError(
+        display_name, 0,
+        "cannot decode image (corrupt or truncated " +
+            std::string(header.format == ImageHeader::Format::kPng ? "PNG"
+                                                                   : "TIFF") +
+            " data)");
   }
   double scale = 1.0;
   switch (raw.depth()) {

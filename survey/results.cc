@@ -257,6 +257,34 @@ std::vector<VertexMatch> ReadMatches(const std::string& path,
 }
 
 // ---------------------------------------------------------------------------
+// skipped_exposures.csv
+
+void WriteSkippedExposures(const std::vector<SkippedExposure>& skipped,
+                           const std::string& path) {
+  AtomicFile file(path);
+  CsvWriter csv(&file.stream());
+  csv.Comment("exposures whose images could not be read: no pose in poses.csv");
+  csv.Header({"exposure_id", "reason"});
+  for (const SkippedExposure& s : skipped) {
+    csv.Add(s.exposure_id).Add(s.reason);
+    csv.EndRow();
+  }
+  file.Commit();
+}
+
+std::vector<SkippedExposure> ReadSkippedExposures(
+    const std::string& path, const std::string& display_name) {
+  const CsvTable csv =
+      CsvTable::Read(path, display_name, {"exposure_id", "reason"});
+  std::vector<SkippedExposure> skipped;
+  for (int row = 0; row < csv.NumRows(); ++row) {
+    skipped.push_back(
+        {csv.GetInt(row, "exposure_id"), csv.GetString(row, "reason")});
+  }
+  return skipped;
+}
+
+// ---------------------------------------------------------------------------
 // crossing_decisions.csv
 
 const char* DecisionName(Decision decision) {

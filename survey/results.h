@@ -27,6 +27,7 @@ inline constexpr char kBandsGeoJsonFile[] = "bands.geojson";
 inline constexpr char kGcpResidualsFile[] = "gcp_residuals.csv";
 inline constexpr char kReportJsonFile[] = "report.json";
 inline constexpr char kReportHtmlFile[] = "report.html";
+inline constexpr char kSkippedExposuresFile[] = "skipped_exposures.csv";
 
 // reconstructed_bands.csv: one row per band vertex seen in one stereo pair.
 struct ReconstructedVertex {
@@ -77,6 +78,18 @@ void WriteCrossingDecisions(const std::vector<CrossingDecision>& decisions,
                             const std::vector<std::string>& comments,
                             const std::string& path);
 std::vector<CrossingDecision> ReadCrossingDecisions(
+    const std::string& path, const std::string& display_name);
+
+// skipped_exposures.csv (written by reconstruct): the exposures whose
+// images could not be read (missing, undecodable, the wrong size). They get
+// no row in poses.csv: SURVEY_FORMAT.md lets only those be left out.
+struct SkippedExposure {
+  int64_t exposure_id = 0;
+  std::string reason;  // free text, commas replaced by ';'
+};
+void WriteSkippedExposures(const std::vector<SkippedExposure>& skipped,
+                           const std::string& path);
+std::vector<SkippedExposure> ReadSkippedExposures(
     const std::string& path, const std::string& display_name);
 
 // poses.csv: one row per image, the camera's projection centre and the

@@ -11,7 +11,9 @@
 
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
+#include "survey/image_io.h"
 #include "survey/input_error.h"
+#include "survey/yaml_document.h"
 
 namespace zebrageo {
 namespace {
@@ -23,11 +25,7 @@ constexpr double kOrthonormalTolerance = 1e-6;
 // unit of the calibration target), not the metres rig.yaml wants.
 constexpr double kMaxPlausibleBaselineM = 10.0;
 
-// 1-based line of `node` for messages (yaml-cpp counts from 0), 0 if unknown.
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.is_null() ? 0 : mark.line + 1;
-}
+int LineOf(const YAML::Node& node) { return YamlLine(node); }
 
 class RigParser {
  public:
@@ -35,13 +33,7 @@ class RigParser {
       : display_name_(std::move(display_name)) {}
 
   Rig Parse(const std::string& yaml_text) const {
-    YAML::Node root;
-    try {
-      root = YAML::Load(yaml_text);
-    } catch (const YAML::Exception& e) {
-      throw InputError(display_name_, e.mark.is_null() ? 0 : e.mark.line + 1,
-                       "malformed YAML: " + e.msg);
-    }
+    const YAML::Node root = ParseYamlDocument(yaml_text, display_name_);
     if (!root.IsMap()) {
       Fail(root, "expected a mapping with 'cameras' and 'stereo_pairs'");
     }
@@ -149,6 +141,12 @@ class RigParser {
         PositiveInt(Require(node, "width", where), where + " width");
     const int height =
         PositiveInt(Require(node, "height", where), where + " height");
+    if (static_cast<int64_t>(width) * height > kMaxImagePixels) {
+      Fail(node["width"],
+           where + " is " + std::to_string(width) + "x" +
+               std::to_string(height) + " pixels, more than the limit of " +
+               std::to_string(kMaxImagePixels / 1000000) + " megapixels");
+    }
 
     const YAML::Node k_node = Require(node, "K", where);
     const std::vector<double> k = Numbers(k_node, 9, where + " K");

@@ -13,6 +13,7 @@
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/yaml_document.h"
 
 namespace zebrageo {
 namespace {
@@ -21,18 +22,16 @@ namespace fs = std::filesystem;
 
 constexpr char kManifestFile[] = "survey.yaml";
 
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.is_null() ? 0 : mark.line + 1;
-}
+int LineOf(const YAML::Node& node) { return YamlLine(node); }
 
 [[noreturn]] void Fail(const YAML::Node& node, const std::string& problem) {
   throw InputError(kManifestFile, LineOf(node), problem);
 }
 
-// A file key: required, a non-empty string naming an existing file.
+// A file key: required, a non-empty string naming a regular file inside
+// the survey folder (unless outside paths are allowed).
 std::string FileKey(const YAML::Node& root, const char* key,
-                    const std::string& survey_folder) {
+                    const SurveyPaths& paths) {
   const YAML::Node node = root[key];
   if (!node || node.IsNull()) {
     Fail(root, std::string("missing key '") + key + "'");
@@ -41,10 +40,10 @@ std::string FileKey(const YAML::Node& root, const char* key,
     Fail(node, std::string("'") + key + "' must be a file name");
   }
   const std::string name = node.Scalar();
-  std::error_code error;
-  if (!fs::is_regular_file(fs::path(survey_folder) / name, error)) {
-    Fail(node,
-         std::string("'") + key + "' names " + name + ", which does not exist");
+  const SurveyFile file = paths.Resolve(name);
+  if (!file.ok()) {
+    Fail(node, std::string("'") + key + "' names " + name + ", which " +
+                   file.Problem());
   }
   return name;
 }
@@ -100,23 +99,25 @@ std::string YamlString(const std::string& text) {
 
 }  // namespace
 
-SurveyManifest ReadManifest(const std::string& survey_folder) {
-  const std::string path = (fs::path(survey_folder) / kManifestFile).string();
-  std::ifstream in(path, std::ios::binary);
+SurveyManifest ReadManifest(const std::string& survey_folder,
+                            const SurveyPathOptions& path_options) {
+  const SurveyPaths paths(survey_folder, path_options);
+  const SurveyFile manifest_file = paths.Resolve(kManifestFile);
+  if (!manifest_file.ok()) {
+    throw InputError(kManifestFile, 0,
+                     "cannot open " + manifest_file.path + ": it " +
+                         manifest_file.Problem() + " (is " + survey_folder +
+                         " a survey folder?)");
+  }
+  std::ifstream in(manifest_file.path, std::ios::binary);
   if (!in) {
-    throw InputError(
-        kManifestFile, 0,
-        "cannot open " + path + " (is " + survey_folder + " a survey folder?)");
+    throw InputError(kManifestFile, 0,
+                     "cannot open " + manifest_file.path + " (is " +
+                         survey_folder + " a survey folder?)");
   }
   std::ostringstream text;
   text << in.rdbuf();
-  YAML::Node root;
-  try {
-    root = YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw InputError(kManifestFile, e.mark.is_null() ? 0 : e.mark.line + 1,
-                     "malformed YAML: " + e.msg);
-  }
+  const YAML::Node root = ParseYamlDocument(text.str(), kManifestFile);
   if (!root.IsMap()) {
     Fail(root,
          "expected a mapping with keys name, rig, trajectory, "
@@ -140,12 +141,15 @@ SurveyManifest ReadManifest(const std::string& survey_folder) {
                           .string();
     }
   }
-  manifest.rig = FileKey(root, "rig", survey_folder);
-  manifest.trajectory = FileKey(root, "trajectory", survey_folder);
-  manifest.exposures = FileKey(root, "exposures", survey_folder);
-  manifest.roadmarks = FileKey(root, "roadmarks", survey_folder);
+  manifest.rig = FileKey(root, "rig", paths);
+  manifest.trajectory = FileKey(root, "trajectory", paths);
+  manifest.exposures = FileKey(root, "exposures", paths);
+  manifest.roadmarks = FileKey(root, "roadmarks", paths);
   const YAML::Node origin = root["origin"];
-  if (origin && !origin.IsNull()) manifest.origin = ParseOrigin(origin);
+  if (origin && !origin.IsNull()) {
+    manifest.origin = ParseOrigin(origin);
+    manifest.origin_line = LineOf(origin);
+  }
   return manifest;
 }
 
@@ -178,6 +182,8 @@ std::string SurveyLoadOptions::Check() const {
             << ": must be in [0, 1]";
     return message.str();
   }
+  const std::string problem = plausibility.Check();
+  if (!problem.empty()) return "plausibility." + problem;
   return "";
 }
 
@@ -192,7 +198,8 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
   }
   Survey survey;
   survey.folder = folder;
-  survey.manifest = ReadManifest(folder);
+  survey.paths = options.paths;
+  survey.manifest = ReadManifest(folder, options.paths);
   const SurveyManifest& manifest = survey.manifest;
 
   survey.rig = ReadRig(survey.PathOf(manifest.rig), manifest.rig);
@@ -225,25 +232,32 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
 
   // Missing images: a few are warnings (the survey stays usable), many mean
   // a wrong folder or a broken copy.
+  // A path out of the folder is refused outright, never read.
+  const SurveyPaths paths(folder, options.paths);
   std::vector<bool> present(survey.exposures.images.size(), true);
   int missing = 0;
   std::string first_missing;
   for (size_t i = 0; i < survey.exposures.images.size(); ++i) {
     const ExposureImage& image = survey.exposures.images[i];
-    std::error_code error;
-    if (!fs::is_regular_file(survey.PathOf(image.image), error)) {
+    const SurveyFile file = paths.Resolve(image.image);
+    if (file.escapes()) {
+      throw InputError(manifest.exposures, image.line,
+                       "image " + image.image + " " + file.Problem());
+    }
+    if (!file.ok()) {
       present[i] = false;
       ++missing;
       const std::string warning = manifest.exposures + ":" +
                                   std::to_string(image.line) + ": image " +
-                                  image.image + " does not exist";
+                                  image.image + " " + file.Problem();
       if (first_missing.empty()) first_missing = warning;
       LOG(WARNING) << warning;
       survey.warnings.push_back(warning);
     }
   }
   const int total = static_cast<int>(survey.exposures.images.size());
-  if (missing > options.max_missing_image_fraction * total) {
+  if (options.require_images &&
+      missing > options.max_missing_image_fraction * total) {
     std::ostringstream message;
     message << missing << " of " << total
             << " images are missing (more than max_missing_image_fraction = "
@@ -252,7 +266,8 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
     throw InputError(manifest.exposures, 0, message.str());
   }
 
-  for (size_t p = 0; p < survey.rig.stereo_pairs.size(); ++p) {
+  for (size_t p = 0;
+       options.require_images && p < survey.rig.stereo_pairs.size(); ++p) {
     const std::array<int, 2>& pair = survey.rig.stereo_pairs[p];
     bool usable = false;
     for (const Exposure& exposure : survey.exposures.exposures) {
@@ -276,6 +291,23 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
   if (options.load_roadmarks) {
     survey.roadmarks =
         ReadRoadmarks(survey.PathOf(manifest.roadmarks), manifest.roadmarks);
+  }
+
+  PlausibilityInput plausibility;
+  plausibility.trajectory = &survey.trajectory;
+  plausibility.trajectory_file = manifest.trajectory;
+  plausibility.exposures = &survey.exposures;
+  plausibility.exposures_file = manifest.exposures;
+  if (options.load_roadmarks) plausibility.roadmarks = &survey.roadmarks;
+  plausibility.roadmarks_file = manifest.roadmarks;
+  plausibility.origin = manifest.origin;
+  plausibility.origin_line = manifest.origin_line;
+  plausibility.manifest_file = kManifestFile;
+  plausibility.frame = &survey.frame;
+  for (const std::string& warning :
+       CheckPlausibility(plausibility, options.plausibility)) {
+    LOG(WARNING) << warning;
+    survey.warnings.push_back(warning);
   }
   return survey;
 }

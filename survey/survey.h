@@ -9,8 +9,10 @@
 
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
+#include "survey/plausibility.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
+#include "survey/survey_paths.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
@@ -22,11 +24,17 @@ struct SurveyManifest {
   std::string exposures = "exposures.csv";
   std::string roadmarks = "roadmarks.geojson";
   std::optional<Geodetic> origin;  // default: the first trajectory sample
+  int origin_line = 0;             // in survey.yaml, for messages
 };
 
-// Reads survey.yaml. Throws InputError for malformed YAML, a missing key, an
-// origin that is not 3 finite numbers, or a named file that does not exist.
-SurveyManifest ReadManifest(const std::string& survey_folder);
+// Reads survey.yaml (a leading UTF-8 byte-order mark is allowed). Throws
+// InputError for malformed YAML, a key given twice, a missing key, an
+// origin that is not 3 finite numbers, or a named file that does not exist,
+// is a folder, a loop of symbolic links or not a regular file, or (unless
+// `paths.allow_outside_paths`) is absolute or resolves outside the survey
+// folder (survey/survey_paths.h).
+SurveyManifest ReadManifest(const std::string& survey_folder,
+                            const SurveyPathOptions& paths = {});
 void WriteManifest(const SurveyManifest& manifest, const std::string& path);
 
 struct SurveyLoadOptions {
@@ -35,6 +43,15 @@ struct SurveyLoadOptions {
   // Share of images that may be missing before the survey is rejected; a few
   // missing images only produce warnings (SURVEY_FORMAT.md).
   double max_missing_image_fraction = 0.2;
+  // Whether the images are needed. adjust works on the geometry alone (its
+  // images only feed tie points): then any share may be missing and a
+  // stereo pair need not have an exposure with both images.
+  bool require_images = true;
+  // Confinement of the files the survey names to its folder.
+  SurveyPathOptions paths;
+  // Checks of a valid survey against physics and itself (gaps, rates,
+  // angle units, distances), run last.
+  PlausibilityOptions plausibility;
 
   std::string Check() const;
 };
@@ -49,6 +66,8 @@ struct Survey {
   RoadmarkDatabase roadmarks;
   // Problems that do not stop processing (missing images...), for report.json.
   std::vector<std::string> warnings;
+  // How the files it names were confined (later readers do the same).
+  SurveyPathOptions paths;
 
   // Absolute path of a file named relative to the survey folder.
   std::string PathOf(const std::string& relative) const;
@@ -56,8 +75,12 @@ struct Survey {
 
 // Loads and cross-validates a survey. Throws InputError: everything the
 // individual readers reject, plus exposures outside the trajectory's time
-// span, too many missing images, a rig without stereo pairs, a stereo pair
-// none of whose exposures has both images. Throws std::invalid_argument when
+// span, an image path that is absolute or resolves outside the survey folder
+// (unless allowed), too many missing images (a folder, a loop of symbolic
+// links or a device in an image's place counts as missing, with its own
+// message), a rig without stereo pairs, a stereo pair none of whose
+// exposures has both images, and what CheckPlausibility refuses; its
+// warnings go to `warnings`. Throws std::invalid_argument when
 // `options.Check()` fails.
 Survey LoadSurvey(const std::string& folder,
                   const SurveyLoadOptions& options = SurveyLoadOptions());

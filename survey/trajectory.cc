@@ -27,6 +27,7 @@ std::vector<TrajectorySample> SamplesFromTable(const CsvTable& table) {
   samples.reserve(table.NumRows());
   for (int row = 0; row < table.NumRows(); ++row) {
     TrajectorySample s;
+    s.line = table.LineOf(row);
     s.time = table.GetDouble(row, "time");
     s.position.lat_deg = table.GetDouble(row, "lat");
     s.position.lon_deg = table.GetDouble(row, "lon");
@@ -136,6 +137,49 @@ bool Trajectory::InterpolatePose(double time, Pose* pose) const {
   const double t1 = samples_[i + 1].time;
   *pose = InterpolatePoses(poses_[i], poses_[i + 1], (time - t0) / (t1 - t0));
   return true;
+}
+
+std::string TrajectoryGapOptions::Check() const {
+  if (!(factor > 1.0)) {
+    return "factor = " + FormatDouble(factor) + ": must be > 1";
+  }
+  if (!(min_duration_s >= 0.0)) {
+    return "min_duration_s = " + FormatDouble(min_duration_s) +
+           ": must be >= 0";
+  }
+  return "";
+}
+
+double MedianSampleInterval(const std::vector<double>& times) {
+  if (times.size() < 2) return 0.0;
+  std::vector<double> intervals;
+  intervals.reserve(times.size() - 1);
+  for (size_t i = 1; i < times.size(); ++i) {
+    intervals.push_back(times[i] - times[i - 1]);
+  }
+  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2,
+                   intervals.end());
+  return intervals[intervals.size() / 2];
+}
+
+std::vector<TrajectoryGap> FindTrajectoryGaps(
+    const std::vector<double>& times, const TrajectoryGapOptions& options) {
+  std::vector<TrajectoryGap> gaps;
+  const double threshold = std::max(
+      options.factor * MedianSampleInterval(times), options.min_duration_s);
+  for (size_t i = 1; i < times.size(); ++i) {
+    if (times[i] - times[i - 1] > threshold) {
+      gaps.push_back({static_cast<int>(i) - 1, times[i - 1], times[i]});
+    }
+  }
+  return gaps;
+}
+
+std::vector<double> SampleTimes(const std::vector<TrajectorySample>& samples) {
+  std::vector<double> times;
+  times.reserve(samples.size());
+  for (const TrajectorySample& sample : samples) times.push_back(sample.time);
+  return times;
 }
 
 std::vector<TrajectorySample> ReadTrajectorySamples(

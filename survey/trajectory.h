@@ -26,6 +26,7 @@ struct TrajectorySample {
   // Standard deviations the GNSS/INS claims (often optimistic).
   Eigen::Vector3d sd_enu_m = Eigen::Vector3d::Zero();         // e, n, u
   Eigen::Vector3d sd_attitude_rad = Eigen::Vector3d::Zero();  // r, p, h
+  int line = 0;  // line in trajectory.csv, for messages; 0: not from a file
 };
 
 struct Pose {
@@ -66,6 +67,37 @@ class Trajectory {
   std::vector<TrajectorySample> samples_;
   std::vector<Pose> poses_;
 };
+
+// A hole in the trajectory: an interval between consecutive samples much
+// longer than its median interval (a lost INS solution, cut rows). A pose
+// interpolated inside it is a guess, and nothing measured across it (a
+// velocity, a jump, a chord) is the vehicle's motion.
+struct TrajectoryGap {
+  int before = 0;           // index of the last sample before the gap
+  double start_time = 0.0;  // of samples[before]
+  double end_time = 0.0;    // of samples[before + 1]
+  double duration() const { return end_time - start_time; }
+};
+
+struct TrajectoryGapOptions {
+  // An interval is a gap when longer than `factor` median intervals and at
+  // least `min_duration_s`: a dropped sample or two of a 100 Hz solution is
+  // not a gap, a second without one is.
+  double factor = 5.0;
+  double min_duration_s = 0.25;
+
+  std::string Check() const;
+};
+
+// Median interval between consecutive `times` (increasing); 0 for fewer
+// than 2 times.
+double MedianSampleInterval(const std::vector<double>& times);
+// The gaps of increasing `times`, in time order.
+std::vector<TrajectoryGap> FindTrajectoryGaps(
+    const std::vector<double>& times,
+    const TrajectoryGapOptions& options = TrajectoryGapOptions());
+// The sample times of a trajectory.
+std::vector<double> SampleTimes(const std::vector<TrajectorySample>& samples);
 
 // Reads trajectory.csv (columns time,lat,lon,h,roll,pitch,heading,sd_e,sd_n,
 // sd_u,sd_roll,sd_pitch,sd_heading; degrees in the file). Throws InputError:

@@ -4,15 +4,20 @@
 // bands.geojson, adjustment.json, a minimal report.json and colmap/.
 #include <glog/logging.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <memory>
+#include <set>
 
 #include "adjustment/adjustment_io.h"
 #include "adjustment/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "survey/atomic_file.h"
+#include "survey/results.h"
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
+#include "tools/results_session.h"
 #include "tools/stages.h"
 
 namespace zebrageo {
@@ -36,17 +41,46 @@ void RunAdjust(const AdjustArguments& args) {
   options.sideslip_sigma_deg = args.sideslip_sigma_deg;
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
-  RunAdjustStage(args.stage.survey, args.stage.results, options,
-                 args.tie_points, args.lines);
+  ResultsSession session(args.stage.results,
+                         ResultsSession::OnError::kRemoveContractOutputs);
+  // The adjustment needs the geometry, not the images (they only feed tie
+  // points), but the survey passes every other check of `run`.
+  SurveyLoadOptions load_options = LoadOptionsOf(args.stage);
+  load_options.require_images = false;
+  const Survey survey = LoadSurvey(args.stage.survey, load_options);
+  session.Open();
+  RunAdjustStage(survey, args.stage.results, options, args.tie_points,
+                 args.lines);
+  session.Succeeded();
+}
+
+// Exposures the reconstruction skipped (their images could not be read):
+// they get no pose (SURVEY_FORMAT.md). Empty without skipped_exposures.csv
+// (results of an older version).
+std::set<int64_t> SkippedExposureIds(const std::string& results_folder) {
+  std::set<int64_t> ids;
+  const std::string path =
+      (std::filesystem::path(results_folder) / kSkippedExposuresFile).string();
+  if (!std::filesystem::exists(path)) return ids;
+  for (const SkippedExposure& s :
+       ReadSkippedExposures(path, kSkippedExposuresFile)) {
+    ids.insert(s.exposure_id);
+  }
+  return ids;
 }
 
 }  // namespace
 
-std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
+std::vector<std::string> RunAdjustStage(const Survey& survey,
                                         const std::string& results_folder,
                                         const AdjustmentOptions& options,
                                         bool tie_points, bool lines) {
-  const AdjustmentData data = LoadAdjustmentData(survey_folder, results_folder);
+  AdjustmentData data =
+      LoadAdjustmentData(survey.folder, results_folder, survey.paths);
+  // The survey's warnings first: adjustment.json and the adjust command's
+  // report.json list them too.
+  data.warnings.insert(data.warnings.begin(), survey.warnings.begin(),
+                       survey.warnings.end());
   LOG(INFO) << "adjust: " << data.vertices.size() << " reconstructed vertices, "
             << data.matches.size() << " matches, "
             << data.exposures.exposures.size() << " exposures";
@@ -81,12 +115,32 @@ std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
     }
   }
   if (!result.summary.IsUsable()) {
+    // A solver's message ("Ceres failed: ...") names no input: the survey's
+    // warnings (gaps, rates, with their lines and times) may.
+    std::string context;
+    for (size_t i = 0; i < survey.warnings.size() && i < 3; ++i) {
+      context +=
+          (i == 0 ? "; the survey's warnings: " : "; ") + survey.warnings[i];
+    }
     throw StageFailedError("adjust: " + result.summary.message +
-                           "; no results were written");
+                           "; no results were written" + context);
   }
+  const std::set<int64_t> skipped = SkippedExposureIds(results_folder);
+  result.camera_poses.erase(
+      std::remove_if(result.camera_poses.begin(), result.camera_poses.end(),
+                     [&skipped](const CameraPose& pose) {
+                       return skipped.count(pose.exposure_id) > 0;
+                     }),
+      result.camera_poses.end());
   RemoveStaleTemporaries(results_folder);
   WriteAdjustmentResults(data, options, result,
                          use_ties ? &tie_summary : nullptr, results_folder);
+  const int removed = RemoveRejectedMatches(data, result, results_folder);
+  if (removed > 0) {
+    LOG(INFO) << "adjust: " << removed
+              << " vertex matches rejected by the adjustment removed from "
+              << kMatchesFile;
+  }
   LOG(INFO) << "adjust: " << result.summary.BriefReport();
   return warnings;
 }

@@ -10,14 +10,18 @@ namespace zebrageo {
 
 void AddCheckCommand(CLI::App* app, std::vector<Command>* commands) {
   auto folder = std::make_shared<std::string>();
+  auto allow_outside_paths = std::make_shared<bool>(false);
   CLI::App* sub = app->add_subcommand(
       "check",
       "Validate a survey folder against the data contract and print a "
       "summary (exit 1 with file:line: problem if it is invalid).");
   sub->add_option("survey", *folder, "survey folder")->required();
+  AddAllowOutsidePathsFlag(sub, allow_outside_paths.get());
   commands->push_back(
-      {sub, [folder] {
-         const Survey survey = LoadSurvey(*folder);
+      {sub, [folder, allow_outside_paths] {
+         SurveyLoadOptions options;
+         options.paths.allow_outside_paths = *allow_outside_paths;
+         const Survey survey = LoadSurvey(*folder, options);
          const Trajectory& trajectory = survey.trajectory;
          std::cout << "survey " << survey.manifest.name << ": "
                    << survey.rig.cameras.size() << " cameras, "

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "survey/survey.h"
+
 namespace zebrageo {
 
 struct Command {
@@ -27,15 +29,23 @@ void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands);
 // run and report.
 void AddRunCommands(CLI::App* app, std::vector<Command>* commands);
 
-// The arguments every stage command takes: SURVEY -o RESULTS.
+// The arguments every stage command takes: SURVEY -o RESULTS
+// [--allow-outside-paths].
 struct StageArguments {
   std::string survey;
   std::string results;
+  // Accept survey files outside the survey folder (survey/survey_paths.h).
+  bool allow_outside_paths = false;
 };
-// Adds a stage subcommand with its two arguments bound to `args`.
+// Adds a stage subcommand with its arguments bound to `args`. A RESULTS
+// that is an existing file is a usage error (exit 2).
 CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
                              const std::string& description,
                              StageArguments* args);
+// Adds --allow-outside-paths to `subcommand`.
+void AddAllowOutsidePathsFlag(CLI::App* subcommand, bool* allow);
+// How a stage command loads its survey.
+SurveyLoadOptions LoadOptionsOf(const StageArguments& args);
 // --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_deg).
 void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg);
 // A runner for a stage that is not built yet: it validates the survey (so

@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -20,6 +21,7 @@
 #include "registration/line_matcher.h"
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
+#include "survey/math_util.h"
 #include "tools/exit_codes.h"
 #include "tools/stages.h"
 
@@ -52,6 +54,50 @@ bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
   return true;
 }
 
+// The posterior horizontal sd (radial) of the corrected trajectory at
+// `time`: from the nearest corrected sample (its sd_* are the posterior
+// ones when the adjustment computed them).
+double PosteriorSdAt(const AdjustmentResult& result, double time) {
+  const auto& samples = result.corrected_samples;
+  if (samples.empty()) return 0.0;
+  const auto it = std::lower_bound(
+      samples.begin(), samples.end(), time,
+      [](const TrajectorySample& s, double t) { return s.time < t; });
+  const TrajectorySample& s = it == samples.end() ? samples.back() : *it;
+  return std::hypot(s.sd_enu_m.x(), s.sd_enu_m.y());
+}
+
+// Database lines whose matched points lie, by their median, further from
+// where the zebra-corrected trajectory puts them than
+// max(kMinLineGateM, kLineGateSigmas x the posterior sd there): rejected;
+// the rest are kept in `kept`.
+constexpr double kMinLineGateM = 0.2;
+constexpr double kLineGateSigmas = 4.0;
+std::vector<RejectedLine> RejectLinesAwayFromTrajectory(
+    const std::vector<LinePointMatch>& matches,
+    const std::vector<double>& sd_of_point, std::vector<LinePointMatch>* kept) {
+  std::map<int, std::vector<double>> distance, gate;
+  for (const LinePointMatch& m : matches) {
+    distance[m.db_line].push_back(m.distance_m);
+    gate[m.db_line].push_back(
+        std::max(kMinLineGateM, kLineGateSigmas * sd_of_point[m.point]));
+  }
+  std::vector<RejectedLine> rejected;
+  std::set<int> away;
+  for (auto& [line, d] : distance) {
+    const double median = Median(d);
+    if (std::abs(median) > Median(gate[line])) {
+      away.insert(line);
+      rejected.push_back({line, static_cast<int>(d.size()), median});
+    }
+  }
+  kept->clear();
+  for (const LinePointMatch& m : matches) {
+    if (!away.count(m.db_line)) kept->push_back(m);
+  }
+  return rejected;
+}
+
 // line_control.json: what the road lines controlled, per stretch of
 // stretch_s seconds from the first exposure (tools/report reads it).
 void WriteLineControlSummary(const std::map<int, std::array<int, 3>>& stretches,
@@ -67,8 +113,9 @@ void WriteLineControlSummary(const std::map<int, std::array<int, 3>>& stretches,
   j["rejected_lines"] = rejected;
   j["note"] =
       "a road line constrains the position across itself and the height, "
-      "never along itself: lane lines control cross-track and height, "
-      "along-track only where stop lines matched";
+      "never along itself: lane lines control cross-track and height; stop "
+      "lines the height only (the zebra crossings beside them hold the "
+      "along-track position)";
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [k, s] : stretches) {
     nlohmann::json controlled = nlohmann::json::array();
@@ -157,18 +204,34 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   for (size_t i = 0; i < enu.size(); ++i) {
     point_time[i] = exposure_time[points[source[i]].exposure_id];
   }
+  std::vector<LinePointMatch> consistent;
+  std::vector<RejectedLine> rejected = RejectInconsistentLines(
+      all_matches, point_time, LineConsistencyOptions(), &consistent);
+  // A database line must also agree with the trajectory the zebra crossings
+  // corrected, to what that trajectory's posterior sd allows: a line the
+  // zebras place decimetres away is stale or mismatched, and would pull
+  // the trajectory off the crossings.
+  std::vector<double> sd_of_point(enu.size(), 0.0);
+  for (size_t i = 0; i < enu.size(); ++i) {
+    sd_of_point[i] = PosteriorSdAt(zebra_result, point_time[i]);
+  }
   std::vector<LinePointMatch> matches;
-  const std::vector<RejectedLine> rejected = RejectInconsistentLines(
-      all_matches, point_time, LineConsistencyOptions(), &matches);
+  for (const RejectedLine& r :
+       RejectLinesAwayFromTrajectory(consistent, sd_of_point, &matches)) {
+    rejected.push_back(r);
+  }
   nlohmann::json rejected_json = nlohmann::json::array();
   for (const RejectedLine& r : rejected) {
     const DatabaseLineEnu& line = database[r.db_line];
+    // The report's wording (tools/report/report.cc), so the warning is
+    // listed once in report.json.
     std::ostringstream w;
-    w << "road-mark database line " << line.id << " (" << line.type << ") lies "
+    w << "database: road line " << line.id << " (" << line.type << ") lies "
       << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
-      << " m across from where the other lines seen with it put it ("
-      << r.points << " points): repainted or stale, not used as control";
+      << " m across from where the other lines put it: repainted or stale, "
+         "not used as control";
     LOG(WARNING) << w.str();
+    warnings->push_back(w.str());
     rejected_json.push_back({{"db_line", line.id},
                              {"type", line.type},
                              {"points", r.points},
@@ -216,13 +279,21 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
         p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
         shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),
         shared * std::max(line.sigma_z_m, options.min_database_sigma_m));
-    control.push_back(c);
     // Across the line is cross-track when the line runs with the vehicle.
     const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
     const bool cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
+    if (!cross_track) {
+      // A line across the road (a stop line) would control the along-track
+      // position, which the zebra crossings it lies beside already hold; a
+      // database's stop lines are drawn loosely (an aerial image shows a
+      // thick bar, a give-way line beside it), so it controls the height
+      // only.
+      c.sqrt_information.row(0).setZero();
+    }
+    control.push_back(c);
     auto& s = stretches[static_cast<int>(
         std::floor((c.time - start_time) / stretch_s))];
-    s[cross_track ? 0 : 2] += 1;
+    if (cross_track) s[0] += 1;
     s[1] += 1;
     csv.Add(p.exposure_id)
         .Add(p.line_id)
@@ -233,7 +304,7 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
         .Add(m.across_enu.y())
         .Add(m.distance_m)
         .Add(m.height_m)
-        .Add("across+height");
+        .Add(cross_track ? "across+height" : "height");
     csv.EndRow();
   }
   file.Commit();
@@ -249,8 +320,7 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
            << s[2] << "]";
   }
   LOG(INFO) << report.str();
-  LOG(INFO) << "road lines control cross-track and height between crossings; "
-               "along-track only where stop lines match";
+  LOG(INFO) << "road lines control cross-track and height between crossings";
   return control;
 }
 

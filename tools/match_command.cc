@@ -13,6 +13,7 @@
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
+#include "tools/results_session.h"
 
 namespace zebrageo {
 
@@ -60,11 +61,15 @@ void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
          if (!problem.empty()) {
            throw UsageError("match: " + problem);
          }
-         const Survey survey = LoadSurvey(args->survey);
+         ResultsSession session(args->results,
+                                ResultsSession::OnError::kKeepOutputs);
+         const Survey survey = LoadSurvey(args->survey, LoadOptionsOf(*args));
+         session.Open();
          if (*second_pass) {
            const RematchSummary summary = RematchWithAdjustedTrajectory(
                survey, args->results, *options, RematchOptions());
            std::cout << summary.message << "\n";
+           session.Succeeded();
            return;
          }
          ProgressBar bar("match");
@@ -75,6 +80,7 @@ void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
            throw StageFailedError(result.summary.message);
          }
          std::cout << result.summary.BriefReport() << "\n";
+         session.Succeeded();
        }});
 }
 

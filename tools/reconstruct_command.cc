@@ -15,6 +15,7 @@
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
+#include "tools/results_session.h"
 #include "tools/stages.h"
 
 namespace zebrageo {
@@ -46,9 +47,12 @@ ReconstructionOptions OptionsFrom(const ReconstructArguments& args) {
 
 void RunReconstruct(const ReconstructArguments& args) {
   const ReconstructionOptions options = OptionsFrom(args);
-  SurveyLoadOptions load_options;
+  ResultsSession session(args.stage.results,
+                         ResultsSession::OnError::kKeepOutputs);
+  SurveyLoadOptions load_options = LoadOptionsOf(args.stage);
   load_options.load_roadmarks = false;
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
+  session.Open();
   ProgressBar bar("reconstruct");
   RoadPlane road_plane;
   RunReconstructStage(survey, options, args.stage.results, bar.Callback(),
@@ -60,6 +64,7 @@ void RunReconstruct(const ReconstructArguments& args) {
                       args.stage.results, lines_bar.Callback());
     lines_bar.Finish();
   }
+  session.Succeeded();
 }
 
 }  // namespace
@@ -118,6 +123,13 @@ std::vector<std::string> RunReconstructStage(
   for (const std::string& warning : summary.warnings) {
     comments.push_back("warning: " + warning);
   }
+  std::vector<SkippedExposure> skipped;
+  for (const auto& [exposure_id, reason] : summary.skipped_exposures) {
+    skipped.push_back({exposure_id, reason});
+  }
+  WriteSkippedExposures(
+      skipped,
+      (std::filesystem::path(results_folder) / kSkippedExposuresFile).string());
   WriteReconstructedBands(
       vertices, comments,
       (std::filesystem::path(results_folder) / kReconstructedBandsFile)

@@ -14,6 +14,7 @@
 #include "tools/exit_codes.h"
 #include "tools/pipeline.h"
 #include "tools/report/report.h"
+#include "tools/results_session.h"
 #include "tools/stages.h"
 
 namespace zebrageo {
@@ -50,9 +51,14 @@ std::vector<std::string> SurveyInputFiles(const Survey& survey) {
 }
 
 void Run(const RunArguments& args) {
+  // One run at a time in a results folder; on any error, no output of the
+  // contract is left (tools/results_session.h).
+  ResultsSession session(args.stage.results,
+                         ResultsSession::OnError::kRemoveContractOutputs);
   // Validate everything before the first output is written: a survey that
-  // cannot be processed leaves the results folder untouched.
-  const Survey survey = LoadSurvey(args.stage.survey);
+  // cannot be processed leaves a new results folder uncreated.
+  const Survey survey =
+      LoadSurvey(args.stage.survey, LoadOptionsOf(args.stage));
   ReconstructionOptions reconstruction;
   reconstruction.threads = args.threads;
   MatchOptions matching;
@@ -64,9 +70,11 @@ void Run(const RunArguments& args) {
     if (!problem.empty()) throw UsageError(problem);
   }
   const std::string results = args.stage.results;
+  session.Open();
 
   std::vector<PipelineStage> stages;
-  std::vector<std::string> reconstruct_outputs = {kReconstructedBandsFile};
+  std::vector<std::string> reconstruct_outputs = {kReconstructedBandsFile,
+                                                  kSkippedExposuresFile};
   if (args.lines) reconstruct_outputs.push_back(kReconstructedLinesFile);
   stages.push_back({"reconstruct", reconstruct_outputs,
                     [&](const std::function<void(int, int)>& progress) {
@@ -100,7 +108,7 @@ void Run(const RunArguments& args) {
                      kBandsGeoJsonFile},
                     [&](const std::function<void(int, int)>&) {
                       std::vector<std::string> warnings =
-                          RunAdjustStage(survey.folder, results, adjustment,
+                          RunAdjustStage(survey, results, adjustment,
                                          args.tie_points, args.lines);
                       if (!args.rematch) return warnings;
                       // Crossings the first pass could not decide, matched
@@ -110,8 +118,13 @@ void Run(const RunArguments& args) {
                           RematchWithAdjustedTrajectory(
                               survey, results, matching, RematchOptions());
                       LOG(INFO) << rematch.message;
+                      // Refused for contradicting the first pass: logged as
+                      // a warning, so listed in report.json too.
+                      if (rematch.disagreements > 0) {
+                        warnings.push_back(rematch.message);
+                      }
                       if (rematch.added == 0) return warnings;
-                      return RunAdjustStage(survey.folder, results, adjustment,
+                      return RunAdjustStage(survey, results, adjustment,
                                             args.tie_points, args.lines);
                     }});
   std::ostringstream settings;
@@ -132,6 +145,7 @@ void Run(const RunArguments& args) {
   for (const auto& warning : report["warnings"]) {
     LOG(WARNING) << warning.get<std::string>();
   }
+  session.Succeeded();
   std::cout << "report: " << results << "/" << kReportHtmlFile << "\n";
 }
 
@@ -144,8 +158,10 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
       "All stages (reconstruct, match, adjust), then report.json and "
       "report.html. A rerun resumes after the last completed stage.",
       &run_args->stage);
+  // Checked while parsing: a typo is a usage error before anything runs.
   run->add_option("--from", run_args->from_stage,
-                  "redo from this stage: reconstruct, match or adjust");
+                  "redo from this stage: reconstruct, match or adjust")
+      ->check(CLI::IsMember({"reconstruct", "match", "adjust"}));
   run->add_option("--threads", run_args->threads,
                   "worker threads (0: one per hardware thread)")
       ->capture_default_str()
@@ -165,11 +181,17 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
       "Write report.json and report.html from an existing results folder.",
       report_args.get());
   commands->push_back({report, [report_args] {
-                         const Survey survey = LoadSurvey(report_args->survey);
+                         ResultsSession session(
+                             report_args->results,
+                             ResultsSession::OnError::kRemoveContractOutputs);
+                         const Survey survey = LoadSurvey(
+                             report_args->survey, LoadOptionsOf(*report_args));
+                         session.Open();
                          ReportInputs inputs;
                          inputs.survey = &survey;
                          inputs.results_folder = report_args->results;
                          WriteReport(inputs, ReportOptions());
+                         session.Succeeded();
                          std::cout << "report: " << report_args->results << "/"
                                    << kReportHtmlFile << "\n";
                        }});

@@ -1,4 +1,5 @@
 // What the stage commands share.
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -13,8 +14,37 @@ CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
                              StageArguments* args) {
   CLI::App* sub = app->add_subcommand(name, description);
   sub->add_option("survey", args->survey, "survey folder")->required();
-  sub->add_option("-o,--output", args->results, "results folder")->required();
+  // A results path that names a file is a mistake on the command line.
+  const CLI::Validator not_a_file(
+      [](std::string& path) -> std::string {
+        std::error_code error;
+        const auto status = std::filesystem::status(path, error);
+        if (std::filesystem::exists(status) &&
+            !std::filesystem::is_directory(status)) {
+          return path + " is a file, not a results folder";
+        }
+        return "";
+      },
+      "FOLDER");
+  sub->add_option("-o,--output", args->results, "results folder")
+      ->required()
+      ->check(not_a_file);
+  AddAllowOutsidePathsFlag(sub, &args->allow_outside_paths);
   return sub;
+}
+
+void AddAllowOutsidePathsFlag(CLI::App* subcommand, bool* allow) {
+  subcommand->add_flag(
+      "--allow-outside-paths", *allow,
+      "read survey files named with an absolute path or resolving outside "
+      "the survey folder (symbolic links included): for your own surveys "
+      "only, never for surveys from others");
+}
+
+SurveyLoadOptions LoadOptionsOf(const StageArguments& args) {
+  SurveyLoadOptions options;
+  options.paths.allow_outside_paths = args.allow_outside_paths;
+  return options;
 }
 
 void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg) {
@@ -31,7 +61,7 @@ std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,
                                           const std::string& stage,
                                           const std::string& issue) {
   return [args, stage, issue] {
-    LoadSurvey(args->survey);
+    LoadSurvey(args->survey, LoadOptionsOf(*args));
     throw NotImplementedError("the " + stage +
                               " stage is not implemented yet (" + issue +
                               "); no results were written");

@@ -43,7 +43,9 @@ void ThrowIfTooManyUnreadable(const Survey& survey,
 // With `lines` and a reconstructed_lines.csv, the adjustment runs twice:
 // zebra crossings alone, then with the road lines matched on that
 // trajectory (line_matches.csv).
-std::vector<std::string> RunAdjustStage(const std::string& survey_folder,
+// The survey's warnings are part of the returned ones (and of
+// adjustment.json's); exposures listed in skipped_exposures.csv get no pose.
+std::vector<std::string> RunAdjustStage(const Survey& survey,
                                         const std::string& results_folder,
                                         const AdjustmentOptions& options,
                                         bool tie_points, bool lines = true);

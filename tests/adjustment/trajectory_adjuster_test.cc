@@ -188,13 +188,14 @@ TEST(TrajectoryAdjuster, DatabaseErrorLargerThanTheDriftDoesNotMakeItWorse) {
   const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
   EXPECT_LT(after.rmse_horizontal_m, 0.5 * before.rmse_horizontal_m);
   EXPECT_LE(after.rmse_vertical_m, before.rmse_vertical_m + 0.005);
-  // The prior it settled on is of the drift's size, not the configured 1 m.
-  EXPECT_GT(result.summary.gnss_sigma_horizontal_m, 0.1);
-  EXPECT_LT(result.summary.gnss_sigma_vertical_m, 0.06);
+  // The process it settled on: a horizontal drift (no shrinkage: several
+  // times the drift), no vertical one (the floor).
+  EXPECT_GT(result.summary.position_sigma_m.x(), 0.1);
+  EXPECT_LT(result.summary.position_sigma_m.z(), 0.06);
 
   // Believing the GNSS/INS no better than 1 m follows the database instead:
   // the test above can fail.
-  adjustment.estimate_gnss_sigma = false;
+  adjustment.estimate_position_model = false;
   const AdjustmentResult blind = AdjustTrajectory(adjustment, f.Input());
   ASSERT_TRUE(blind.summary.IsUsable()) << blind.summary.message;
   const PoseErrors followed = ScorePoses(f.survey, blind.camera_poses);
@@ -284,8 +285,11 @@ TEST(TrajectoryAdjuster, VehicleMotionHoldsTheHeadingBetweenCrossings) {
   EXPECT_LT(error_with.rmse_attitude_deg, error_without.rmse_attitude_deg);
   EXPECT_LT(error_with.rmse_horizontal_m,
             1.15 * error_without.rmse_horizontal_m);
-  // The synthetic INS sits on the axle, aligned with the vehicle.
-  EXPECT_LT(std::abs(b.summary.vehicle_yaw_misalignment_deg), 0.02);
+  // The synthetic INS sits on the axle, aligned with the vehicle. The
+  // misalignment trades off with the INS's mean heading error (0.15 deg of
+  // drift here); the constraints, counted once per second of sideslip
+  // correlation rather than each at 10 Hz, hold it to a few hundredths.
+  EXPECT_LT(std::abs(b.summary.vehicle_yaw_misalignment_deg), 0.03);
   EXPECT_LT(std::abs(b.summary.vehicle_axle_offset_m), 0.5);
   bool reported = false;
   for (const ObservationRms& rms : b.summary.rms) {

@@ -277,6 +277,52 @@ TEST(BandMatcher,
   }
 }
 
+// A perfect image probe: paint where the street has a band (unknown where
+// the scene's occluder hides one of its first `hidden` bands), bare road
+// elsewhere.
+MatchInput WithPerfectProbe(const SyntheticScene& scene,
+                            const RoadmarkIndex& index, int hidden) {
+  MatchInput input = scene.Input(index);
+  input.paint_probe = [&scene, hidden](int64_t, const Pose&,
+                                       const BandCornersEnu& band,
+                                       const std::vector<BandCornersEnu>&) {
+    const Eigen::Vector3d centre =
+        0.25 * (band[0] + band[1] + band[2] + band[3]);
+    for (const auto& [key, corners] : scene.truth) {
+      const Eigen::Vector3d c =
+          0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+      if ((c - centre).head<2>().norm() > 0.3) continue;
+      return key.second <= hidden ? PaintEvidence::kUnknown
+                                  : PaintEvidence::kPaint;
+    }
+    return PaintEvidence::kBareRoad;
+  };
+  return input;
+}
+
+TEST(BandMatcher, ADatabaseLackingItsLastBandWithBandOneHiddenIsRefused) {
+  // The double fault no evidence separates from a one-band shift: the
+  // database lost the last band (its numbering cannot tell) and a parked
+  // vehicle hides band 1 from every view. The bands fit 2..n as well as
+  // 1..n-1; the decision would rest on band counts at one end: refused,
+  // never guessed.
+  for (int seed = 1; seed <= 3; ++seed) {
+    SyntheticSceneOptions options = Street(40 + seed, 5);
+    for (SyntheticCrossingSpec& c : options.crossings) {
+      c.database_lacks = {c.bands};
+      c.occluded_bands = 1;
+      c.occluded_beyond_m = 1e-3;
+    }
+    const SyntheticScene scene = MakeSyntheticScene(options);
+    const RoadmarkIndex index(scene.database, scene.frame);
+    const MatchResult result =
+        MatchBands(WithPerfectProbe(scene, index, 1), MatchOptions());
+    const MatchScore score = ScoreMatches(scene, result.matches);
+    SCOPED_TRACE(result.summary.BriefReport());
+    EXPECT_EQ(score.wrong, 0);
+  }
+}
+
 TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
   // The database has crossing C03 one band period off (a wrong survey): it
   // still fits perfectly alone, but implies a correction 1 m away from the

@@ -33,6 +33,26 @@ TEST(CsvTable, SkipsCommentsAndBlankLinesAndKeepsFileLineNumbers) {
   EXPECT_EQ(table.GetInt(1, "b"), 4);
 }
 
+TEST(CsvTable, IgnoresALeadingUtf8ByteOrderMark) {
+  const CsvTable table =
+      CsvTable::Parse("\xEF\xBB\xBFtime,a\n1,2\n", "t.csv", {"time", "a"});
+  ASSERT_EQ(table.NumRows(), 1);
+  EXPECT_EQ(table.LineOf(0), 2);
+  EXPECT_DOUBLE_EQ(table.GetDouble(0, "time"), 1.0);
+  // Before comments too, and only at the very start of the file.
+  EXPECT_EQ(CsvTable::Parse("\xEF\xBB\xBF# c\ntime\n1\n", "t.csv", {"time"})
+                .NumRows(),
+            1);
+  EXPECT_THAT(MessageOf([] {
+                CsvTable::Parse(
+                    "time\n\xEF\xBB\xBF"
+                    "1\n",
+                    "t.csv", {"time"})
+                    .GetDouble(0, "time");
+              }),
+              HasSubstr("t.csv:2: column 'time'"));
+}
+
 TEST(CsvTable, FindsColumnsByNameAndAllowsExtraColumns) {
   const CsvTable table =
       CsvTable::Parse("b,extra,a\n2.5,x,-1e3\n", "t.csv", {"a", "b"});

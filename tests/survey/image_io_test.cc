@@ -2,6 +2,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -13,6 +14,28 @@ namespace zebrageo {
 namespace {
 
 using ::testing::HasSubstr;
+
+// The chunks of a PNG up to its (empty) image data: the signature, an IHDR
+// claiming width x height 8-bit grey pixels, and an IDAT of no bytes. What
+// a header reader sees of any PNG of that size.
+std::string PngHeaderClaiming(uint32_t width, uint32_t height) {
+  auto big_endian = [](uint32_t v) {
+    return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16),
+                       static_cast<char>(v >> 8), static_cast<char>(v)};
+  };
+  auto chunk = [&](const std::string& type, const std::string& data) {
+    const std::string body = type + data;
+    const uLong crc =
+        crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(body.data()),
+              static_cast<uInt>(body.size()));
+    return big_endian(static_cast<uint32_t>(data.size())) + body +
+           big_endian(static_cast<uint32_t>(crc));
+  };
+  const std::string ihdr = big_endian(width) + big_endian(height) +
+                           std::string("\x08\x00\x00\x00\x00", 5);
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) +
+         chunk("IDAT", "");
+}
 
 std::string ErrorOfRead(const std::string& path, int width = 0,
                         int height = 0) {
@@ -86,11 +109,55 @@ TEST(ReadGrayImage, RejectsGarbageBytes) {
   const std::string path = folder.Write(
       "garbage.png", std::string("\x89PNG\r\n\x1a\n\x01\x02garbage", 18));
   EXPECT_THAT(ErrorOfRead(path),
-              HasSubstr("images/x.png: cannot decode image (not a PNG/TIFF?)"));
+              HasSubstr("images/x.png: cannot decode image: corrupt PNG "
+                        "header"));
   const std::string text = folder.Write("text.png", "hello, world\n");
-  EXPECT_THAT(ErrorOfRead(text), HasSubstr("cannot decode image"));
+  EXPECT_THAT(ErrorOfRead(text),
+              HasSubstr("cannot decode image (not a PNG or TIFF file)"));
+  // A valid header and nothing after it.
+  const std::string truncated =
+      folder.Write("truncated.png", PngHeaderClaiming(64, 48));
+  EXPECT_THAT(ErrorOfRead(truncated),
+              HasSubstr("cannot decode image (corrupt or truncated PNG "
+                        "data)"));
   const std::string empty = folder.Write("empty.png", "");
   EXPECT_THAT(ErrorOfRead(empty), HasSubstr("cannot decode image"));
+}
+
+TEST(ReadImageHeader, GivesTheSizeOfPngAndTiffWithoutDecoding) {
+  TemporaryFolder folder;
+  const cv::Mat image(48, 64, CV_16UC1, cv::Scalar(7));
+  for (const char* name : {"a.png", "a.tif"}) {
+    ASSERT_TRUE(cv::imwrite(folder.Path(name), image));
+    const ImageHeader header = ReadImageHeader(folder.Path(name), name);
+    EXPECT_EQ(header.width, 64) << name;
+    EXPECT_EQ(header.height, 48) << name;
+    EXPECT_EQ(header.format, std::string(name) == "a.png"
+                                 ? ImageHeader::Format::kPng
+                                 : ImageHeader::Format::kTiff);
+  }
+  // Only the header is read: a 20000x20000 claim with no pixel data.
+  const ImageHeader big = ReadImageHeader(
+      folder.Write("big.png", PngHeaderClaiming(20000, 20000)), "big.png");
+  EXPECT_EQ(big.pixels(), 400000000);
+}
+
+TEST(ReadGrayImage, RefusesAnImageOverTheLimitBeforeDecodingIt) {
+  TemporaryFolder folder;
+  // The old reader decoded first: 400 MB, then 1.6 GB as floats.
+  const std::string path =
+      folder.Write("big.png", PngHeaderClaiming(20000, 20000));
+  for (const int width : {0, 1280}) {
+    EXPECT_THAT(ErrorOfRead(path, width, 960),
+                HasSubstr("images/x.png: image is 20000x20000 pixels, more "
+                          "than the limit of 64 megapixels (from its header; "
+                          "not decoded)"));
+  }
+  const std::string small =
+      folder.Write("small.png", PngHeaderClaiming(1280, 960));
+  EXPECT_THAT(ErrorOfRead(small, 640, 480),
+              HasSubstr("image is 1280x960 pixels but the rig's camera is "
+                        "640x480 (from its header; not decoded)"));
 }
 
 TEST(ReadGrayImage, RejectsAnImageOfTheWrongSize) {

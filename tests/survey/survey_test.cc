@@ -12,6 +12,7 @@
 namespace zebrageo {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 const char kManifest[] =
@@ -40,12 +41,22 @@ const char kRig[] =
     "stereo_pairs:\n"
     "  - [left, right]\n";
 
+// 10 Hz (the contract's lowest rate) from 100.0 to 101.0 s, heading east at
+// 10 m/s.
 const char kTrajectory[] =
     "# time span 100 .. 101 s\n"
     "time,lat,lon,h,roll,pitch,heading,sd_e,sd_n,sd_u,sd_roll,sd_pitch,"
     "sd_heading\n"
     "100.0,49.8941,2.2958,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.1,49.8941,2.295814,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.2,49.8941,2.295828,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.3,49.8941,2.295842,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.4,49.8941,2.295856,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
     "100.5,49.8941,2.29587,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.6,49.8941,2.295884,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.7,49.8941,2.295898,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.8,49.8941,2.295912,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
+    "100.9,49.8941,2.295926,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n"
     "101.0,49.8941,2.29594,60,0,0,90,0.02,0.02,0.03,0.01,0.01,0.05\n";
 
 // Ten stereo exposures between 100.1 and 101.0 s.
@@ -107,7 +118,7 @@ TEST(Survey, LoadsAValidSurvey) {
   const Survey survey = LoadSurvey(survey_folder.path());
   EXPECT_EQ(survey.manifest.name, "test-survey");
   EXPECT_EQ(survey.rig.cameras.size(), 2u);
-  EXPECT_EQ(survey.trajectory.size(), 3);
+  EXPECT_EQ(survey.trajectory.size(), 11);
   EXPECT_EQ(survey.exposures.images.size(), 20u);
   EXPECT_EQ(survey.exposures.exposures.size(), 10u);
   EXPECT_EQ(survey.roadmarks.bands.size(), 1u);
@@ -222,6 +233,110 @@ TEST(Survey, RejectsAStereoPairWithoutAnyCompleteExposure) {
   EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
               HasSubstr("exposures.csv: stereo pair 0 (left, right): no "
                         "exposure has existing images of both cameras"));
+}
+
+TEST(Survey, RefusesFilesOutsideTheSurveyFolder) {
+  const SurveyFolder survey_folder;
+  const TemporaryFolder& folder = survey_folder.folder();
+  // A valid image and a valid trajectory beside the survey: refused, unread.
+  folder.Write("../" +
+                   std::filesystem::path(folder.Path()).filename().string() +
+                   "-outside.png",
+               "png");
+  const std::string outside =
+      folder.Path() + "-outside.png";  // the sibling just written
+  std::string exposures = Exposures();
+  exposures.replace(exposures.find("images/l100.png"), 15,
+                    "../" + std::filesystem::path(outside).filename().string());
+  folder.Write("exposures.csv", exposures);
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              AllOf(HasSubstr("exposures.csv:2: image ../"),
+                    HasSubstr(", outside the survey folder")));
+  SurveyLoadOptions trusted;
+  trusted.paths.allow_outside_paths = true;
+  EXPECT_EQ(LoadSurvey(survey_folder.path(), trusted).warnings.size(), 0u);
+  std::filesystem::remove(outside);
+
+  folder.Write("exposures.csv", Exposures());
+  folder.Write("survey.yaml",
+               "name: x\nrig: /etc/passwd\ntrajectory: trajectory.csv\n"
+               "exposures: exposures.csv\nroadmarks: roadmarks.geojson\n");
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              HasSubstr("survey.yaml:2: 'rig' names /etc/passwd, which is an "
+                        "absolute path"));
+  folder.Write("survey.yaml",
+               "name: x\nrig: rig.yaml\ntrajectory: ../../../../etc/shadow\n"
+               "exposures: exposures.csv\nroadmarks: roadmarks.geojson\n");
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              HasSubstr("survey.yaml:3: 'trajectory' names "
+                        "../../../../etc/shadow, which resolves to "
+                        "/etc/shadow, outside the survey folder"));
+}
+
+TEST(Survey, NamesAFolderOrALoopWhereAFileIsExpected) {
+  const SurveyFolder survey_folder;
+  const TemporaryFolder& folder = survey_folder.folder();
+  folder.Write("survey.yaml",
+               "name: x\nrig: rig.yaml\ntrajectory: images\n"
+               "exposures: exposures.csv\nroadmarks: roadmarks.geojson\n");
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              HasSubstr("survey.yaml:3: 'trajectory' names images, which is "
+                        "a folder, not a file"));
+  folder.Write("survey.yaml", kManifest);
+  std::filesystem::remove(folder.Path("images/l101.png"));
+  std::filesystem::create_directory(folder.Path("images/l101.png"));
+  std::filesystem::remove(folder.Path("images/r101.png"));
+  std::filesystem::create_symlink("r101.png", folder.Path("images/r101.png"));
+  const Survey survey = LoadSurvey(survey_folder.path());
+  ASSERT_EQ(survey.warnings.size(), 2u);
+  EXPECT_EQ(survey.warnings[0],
+            "exposures.csv:4: image images/l101.png is a folder, not a file");
+  EXPECT_THAT(survey.warnings[1],
+              HasSubstr("exposures.csv:5: image images/r101.png is a loop of "
+                        "symbolic links"));
+}
+
+TEST(Survey, RefusesAKeyGivenTwice) {
+  const SurveyFolder survey_folder;
+  survey_folder.folder().Write(
+      "survey.yaml", std::string(kManifest) + "trajectory: rig.yaml\n");
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              HasSubstr("survey.yaml:6: duplicate key 'trajectory' (first on "
+                        "line 3)"));
+}
+
+TEST(Survey, AcceptsUtf8ByteOrderMarks) {
+  const SurveyFolder survey_folder;
+  const TemporaryFolder& folder = survey_folder.folder();
+  const std::string bom = "\xEF\xBB\xBF";
+  folder.Write("survey.yaml", bom + kManifest);
+  folder.Write("rig.yaml", bom + kRig);
+  folder.Write("trajectory.csv", bom + kTrajectory);
+  folder.Write("exposures.csv", bom + Exposures());
+  const Survey survey = LoadSurvey(survey_folder.path());
+  EXPECT_EQ(survey.trajectory.size(), 11);
+  EXPECT_EQ(survey.exposures.images.size(), 20u);
+  EXPECT_EQ(survey.rig.cameras.size(), 2u);
+}
+
+TEST(Survey, RunsThePlausibilityChecks) {
+  const SurveyFolder survey_folder;
+  // An origin 112 km from the trajectory: an error on its line.
+  survey_folder.folder().Write(
+      "survey.yaml", std::string(kManifest) + "origin: [50.9, 2.2958, 60]\n");
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              HasSubstr("survey.yaml:6: 'origin' (50.900000, 2.295800) is 112 "
+                        "km from the nearest sample of trajectory.csv"));
+}
+
+TEST(Survey, WithoutRequiredImagesAnyShareMayBeMissing) {
+  const SurveyFolder survey_folder;
+  std::filesystem::remove_all(survey_folder.folder().Path("images"));
+  EXPECT_THAT(ErrorOfLoad(survey_folder.path()),
+              HasSubstr("20 of 20 images are missing"));
+  SurveyLoadOptions geometry;
+  geometry.require_images = false;
+  EXPECT_EQ(LoadSurvey(survey_folder.path(), geometry).warnings.size(), 20u);
 }
 
 TEST(Survey, OptionsCheckNamesTheFieldAndValue) {

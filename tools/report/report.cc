@@ -22,6 +22,17 @@ namespace {
 
 using nlohmann::json;
 
+// `texts` in order, each once: a warning can reach the report by two ways
+// (a stage's list and the file it wrote).
+std::vector<std::string> WithoutRepeats(const std::vector<std::string>& texts) {
+  std::vector<std::string> unique;
+  std::set<std::string> seen;
+  for (const std::string& text : texts) {
+    if (seen.insert(text).second) unique.push_back(text);
+  }
+  return unique;
+}
+
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // Everything the report shows, gathered once from the results folder.
@@ -398,10 +409,18 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
   if (inputs.peak_memory_mb > 0.0)
     report["peak_memory_mb"] = inputs.peak_memory_mb;
 
-  // Warnings: the survey's, the stages', and what the figures show.
+  // Warnings: the survey's, the stages' (those the match and adjust stages
+  // recorded in their files too, so that every warning they logged is
+  // here, resumed stages included), and what the figures show.
   std::vector<std::string> warnings = survey.warnings;
   warnings.insert(warnings.end(), inputs.warnings.begin(),
                   inputs.warnings.end());
+  for (const json* stage_file : {&data.match_evidence, &data.adjustment}) {
+    if (!stage_file->is_object()) continue;
+    for (const json& w : stage_file->value("warnings", json::array())) {
+      if (w.is_string()) warnings.push_back(w.get<std::string>());
+    }
+  }
   for (const std::string& file : data.missing_files) {
     warnings.push_back("no " + file + " in the results folder");
   }
@@ -456,7 +475,7 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
                          fault["description"].get<std::string>());
     }
   }
-  report["warnings"] = warnings;
+  report["warnings"] = WithoutRepeats(warnings);
   return report;
 }
 

@@ -1,0 +1,319 @@
+#include "adjustment/adjustment_outputs.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+#include "survey/math_util.h"
+
+namespace zebrageo {
+namespace adjustment_internal {
+namespace {
+
+// Corrected samples and poses, one per input sample; the correction's size.
+bool FillTrajectory(const OutputContext& context, const State& state,
+                    AdjustmentResult* result) {
+  const Trajectory& trajectory = *context.input->trajectory;
+  const LocalFrame& frame = *context.input->frame;
+  AdjustmentSummary& summary = result->summary;
+  std::vector<double> correction_h, sd_h, sd_v;
+  for (int i = 0; i < trajectory.size(); ++i) {
+    const TrajectorySample& sample = trajectory.samples()[i];
+    if (!context.adjusted) {
+      result->corrected_poses.push_back(trajectory.poses()[i]);
+      result->corrected_samples.push_back(sample);
+      correction_h.push_back(0.0);
+      continue;
+    }
+    Pose corrected =
+        state.correction.Apply(sample.time, context.dejumped->poses[i]);
+    corrected.p_enu += ExposureOffsetAt(state, sample.time);
+    if (!corrected.p_enu.allFinite() ||
+        !corrected.q_enu_body.coeffs().allFinite()) {
+      summary.message = "the corrected trajectory is not finite";
+      return false;
+    }
+    result->corrected_poses.push_back(corrected);
+    Eigen::Vector3d sd_enu = sample.sd_enu_m;
+    if (!context.sample_covariance.empty()) {
+      sd_enu =
+          context.sample_covariance[i].diagonal().cwiseMax(0.0).cwiseSqrt();
+      sd_h.push_back(std::hypot(sd_enu.x(), sd_enu.y()));
+      sd_v.push_back(sd_enu.z());
+    }
+    result->corrected_samples.push_back(SampleFromPose(
+        sample.time, corrected, frame, sd_enu, sample.sd_attitude_rad));
+    const Eigen::Vector3d d = corrected.p_enu - trajectory.poses()[i].p_enu;
+    correction_h.push_back(d.head<2>().norm());
+    summary.max_correction_horizontal_m =
+        std::max(summary.max_correction_horizontal_m, d.head<2>().norm());
+    summary.max_correction_vertical_m =
+        std::max(summary.max_correction_vertical_m, std::abs(d.z()));
+  }
+  summary.rms_correction_horizontal_m = Rms(correction_h);
+  summary.median_posterior_sd_horizontal_m = Median(sd_h);
+  summary.median_posterior_sd_vertical_m = Median(sd_v);
+  return true;
+}
+
+// One camera pose per row of exposures.csv.
+void FillCameraPoses(const OutputContext& context, const State& state,
+                     AdjustmentResult* result) {
+  const Rig& rig = *context.input->rig;
+  int no_pose = 0;
+  for (const ExposureImage& image : context.input->exposures->images) {
+    Pose corrected;
+    if (!OutputPoseAt(context, state, image.time, &corrected)) {
+      ++no_pose;
+      continue;
+    }
+    const Eigen::Isometry3d T_enu_cam =
+        corrected.T_enu_body() * result->T_body_cam[image.camera];
+    CameraPose pose;
+    pose.exposure_id = image.exposure_id;
+    pose.camera = rig.cameras[image.camera].camera.name();
+    pose.time = image.time;
+    pose.p_enu = T_enu_cam.translation();
+    pose.position = context.input->frame->GeodeticFromEnu(pose.p_enu);
+    pose.q_enu_cam = Eigen::Quaterniond(T_enu_cam.linear()).normalized();
+    result->camera_poses.push_back(pose);
+  }
+  if (no_pose > 0) {
+    context.warn(std::to_string(no_pose) +
+                 " images were taken outside the trajectory's time span: no "
+                 "pose");
+  }
+}
+
+// Each reconstructed band placed with the corrected trajectory.
+void FillBands(const OutputContext& context, State* state,
+               AdjustmentResult* result) {
+  std::unordered_map<int64_t, double> exposure_time;
+  for (const Exposure& e : context.input->exposures->exposures) {
+    exposure_time[e.exposure_id] = e.time;
+  }
+  // Bands placed with the corrected trajectory.
+  std::map<std::pair<int64_t, int64_t>,
+           std::array<const ReconstructedVertex*, 4>>
+      band_vertices;
+  for (const ReconstructedVertex& v : *context.input->vertices) {
+    if (v.vertex < 0 || v.vertex > 3) continue;
+    auto& slots = band_vertices[{v.exposure_id, v.band_id}];
+    slots[v.vertex] = &v;
+  }
+  std::map<std::pair<int64_t, int64_t>, const VertexMatch*> band_match;
+  for (const VertexMatch& m : *context.input->matches) {
+    band_match.emplace(std::make_pair(m.exposure_id, m.band_id), &m);
+  }
+  for (const auto& [key, slots] : band_vertices) {
+    if (std::any_of(
+            slots.begin(), slots.end(),
+            [](const ReconstructedVertex* v) { return v == nullptr; })) {
+      continue;
+    }
+    const auto t = exposure_time.find(key.first);
+    Pose pose;
+    if (t == exposure_time.end() ||
+        !OutputPoseAt(context, *state, t->second, &pose)) {
+      continue;
+    }
+    const Eigen::Isometry3d T_enu_body = pose.T_enu_body();
+    AdjustedBand band;
+    band.exposure_id = key.first;
+    band.band_id = key.second;
+    for (int v = 0; v < 4; ++v) {
+      band.corners[v] =
+          context.input->frame->GeodeticFromEnu(T_enu_body * slots[v]->p_body);
+    }
+    const auto m = band_match.find(key);
+    if (m != band_match.end()) {
+      band.crossing_id = m->second->crossing_id;
+      band.band = m->second->band;
+    }
+    result->bands.push_back(band);
+  }
+}
+
+// Control, check and rejected points with their residuals; the summary's
+// counts and RMSEs.
+void FillControlPoints(const OutputContext& context, State* state,
+                       AdjustmentResult* result) {
+  const AdjustmentOptions& options = *context.options;
+  const Rig& rig = *context.input->rig;
+  AdjustmentSummary& summary = result->summary;
+  // Control and check points. Held-out check points are reported with their
+  // residuals from the adjustment that did not see them.
+  for (ControlPoint& p : state->points) {
+    if (p.held_out && p.status == ControlStatus::kControl) {
+      p.status = ControlStatus::kCheck;
+      p.normalized_residual = p.held_out_normalized_residual;
+      summary.check_points_in_final = true;
+    }
+  }
+  std::vector<double> control_h, control_v, check_h, check_v;
+  // What the database alone puts into a check residual, per the model the
+  // adjustment uses for it: the vertex sigma and the crossing offset.
+  std::vector<double> database_h, database_v;
+  const double offset_variance =
+      options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
+  for (ControlPoint& p : state->points) {
+    ControlPointResult r;
+    r.crossing_id = p.crossing_id;
+    r.band = p.band;
+    r.db_vertex = p.db_vertex;
+    r.status = p.status;
+    r.database_enu = p.database_enu;
+    r.normalized_residual = p.normalized_residual;
+    r.n_images = static_cast<int>(p.observations.size());
+    Eigen::Matrix3d covariance;
+    double rms_px = 0.0;
+    Eigen::Vector3d X;
+    const bool from_held_out = p.held_out && p.status == ControlStatus::kCheck;
+    if (from_held_out) {
+      X = p.held_out_enu;
+      rms_px = p.held_out_rms_px;
+    }
+    const bool triangulated =
+        from_held_out
+            ? p.held_out_triangulated
+            : StereoPosition(options, *state, p.stereo, &X, &covariance);
+    if (triangulated && !from_held_out) {
+      std::vector<double> errors;
+      for (const ImageObservation& o : p.observations) {
+        Eigen::Vector2d e;
+        if (PixelResidual(rig, *state, o, X, &e)) errors.push_back(e.norm());
+      }
+      rms_px = Rms(errors);
+    }
+    r.image_enu = triangulated ? X : p.database_enu;
+    if (p.status == ControlStatus::kControl) {
+      r.adjusted_enu = p.estimate;
+      std::vector<double> errors;
+      for (const ImageObservation& o : p.observations) {
+        Eigen::Vector2d e;
+        if (PixelResidual(rig, *state, o, p.estimate, &e)) {
+          errors.push_back(e.norm() / std::sqrt(2.0));
+        }
+      }
+      r.rms_px = Rms(errors);
+    } else {
+      r.adjusted_enu = r.image_enu;
+      r.rms_px = rms_px / std::sqrt(2.0);
+    }
+    const Eigen::Vector3d d = r.adjusted_enu - r.database_enu;
+    if (p.status == ControlStatus::kControl) {
+      ++summary.num_control_points;
+      control_h.push_back(d.head<2>().norm());
+      control_v.push_back(d.z());
+    } else if (p.status == ControlStatus::kCheck) {
+      ++summary.num_check_points;
+      if (triangulated) {
+        check_h.push_back(d.head<2>().norm());
+        check_v.push_back(d.z());
+        database_h.push_back(std::sqrt(p.sigma_m.head<2>().squaredNorm() +
+                                       2.0 * offset_variance));
+        database_v.push_back(
+            std::sqrt(p.sigma_m.z() * p.sigma_m.z() + offset_variance));
+      }
+    } else {
+      ++summary.num_rejected_points;
+    }
+    result->control_points.push_back(r);
+  }
+  std::set<int> control_crossings, check_crossings;
+  for (const ControlPoint& p : state->points) {
+    if (p.status == ControlStatus::kControl)
+      control_crossings.insert(p.crossing);
+    if (p.status == ControlStatus::kCheck) check_crossings.insert(p.crossing);
+  }
+  summary.num_control_crossings = static_cast<int>(control_crossings.size());
+  summary.num_check_crossings = static_cast<int>(check_crossings.size());
+  summary.control_rmse_horizontal_m = Rms(control_h);
+  summary.control_rmse_vertical_m = Rms(control_v);
+  summary.check_rmse_horizontal_m = Rms(check_h);
+  summary.check_rmse_vertical_m = Rms(check_v);
+  summary.num_check_points_evaluated = static_cast<int>(check_h.size());
+  summary.check_database_rms_horizontal_m = Rms(database_h);
+  summary.check_database_rms_vertical_m = Rms(database_v);
+  auto implied = [](double rmse, double database) {
+    return std::sqrt(std::max(0.0, rmse * rmse - database * database));
+  };
+  summary.check_implied_trajectory_horizontal_m = implied(
+      summary.check_rmse_horizontal_m, summary.check_database_rms_horizontal_m);
+  summary.check_implied_trajectory_vertical_m = implied(
+      summary.check_rmse_vertical_m, summary.check_database_rms_vertical_m);
+  if (summary.num_rejected_points > 0) {
+    std::set<std::string> names;
+    for (const ControlPoint& p : state->points) {
+      if (p.status == ControlStatus::kRejected) names.insert(p.crossing_id);
+    }
+    std::string list;
+    for (const std::string& name : names)
+      list += (list.empty() ? "" : ", ") + name;
+    context.warn(std::to_string(summary.num_rejected_points) +
+                 " control vertices rejected (crossings " + list +
+                 "): inconsistent with the other crossings, or blunders; not "
+                 "used as control, removed from matches.csv");
+  }
+}
+
+}  // namespace
+
+Eigen::Vector3d ExposureOffsetAt(const State& state, double time) {
+  const std::vector<double>& times = state.exposure_times;
+  if (!state.model.HasJitter() || times.empty() || time < times.front() ||
+      time > times.back()) {
+    return Eigen::Vector3d::Zero();
+  }
+  // ENU offset of exposure e, from its track frame.
+  auto enu = [&state](int e) -> Eigen::Vector3d {
+    return state.exposure_frames[e] * state.exposure_offsets[e];
+  };
+  const auto it = std::lower_bound(times.begin(), times.end(), time);
+  const int b = static_cast<int>(it - times.begin());
+  if (std::abs(times[b] - time) < 1e-6 || b == 0) return enu(b);
+  const double u = (time - times[b - 1]) / (times[b] - times[b - 1]);
+  return (1.0 - u) * enu(b - 1) + u * enu(b);
+}
+
+bool OutputPoseAt(const OutputContext& context, const State& state, double time,
+                  Pose* pose) {
+  const Trajectory& trajectory = *context.input->trajectory;
+  if (!context.adjusted) return trajectory.InterpolatePose(time, pose);
+  Pose ins_pose;
+  if (!InterpolateDejumped(trajectory, *context.dejumped, time, &ins_pose)) {
+    return false;
+  }
+  *pose = state.correction.Apply(time, ins_pose);
+  pose->p_enu += ExposureOffsetAt(state, time);
+  return true;
+}
+
+bool FillOutputs(const OutputContext& context, State* state,
+                 AdjustmentResult* result) {
+  const Rig& rig = *context.input->rig;
+  result->correction = state->correction;
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    result->T_body_cam.push_back(CorrectedBodyFromCamera(
+        rig.cameras[c].T_body_cam, state->rig_corrections[c]));
+  }
+  if (!FillTrajectory(context, *state, result)) return false;
+  FillCameraPoses(context, *state, result);
+  FillBands(context, state, result);
+  FillControlPoints(context, state, result);
+  // Tie points after adjustment.
+  for (const TiePoint& tie : state->ties) {
+    TieTrack track = (*context.input->tie_tracks)[tie.source];
+    track.p_enu = tie.estimate;
+    result->tie_tracks.push_back(track);
+  }
+
+  return true;
+}
+
+}  // namespace adjustment_internal
+}  // namespace zebrageo

@@ -1,0 +1,212 @@
+#include "adjustment/control_selection.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "survey/math_util.h"
+
+namespace zebrageo {
+namespace adjustment_internal {
+namespace {
+
+// Above this many crossings the leave-one-out test keeps the error model
+// fitted on all of them (a refit per crossing would cost n^4).
+constexpr int kMaxCrossingsForRefit = 40;
+
+std::string Fixed(double value, int decimals) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(decimals) << value;
+  return out.str();
+}
+
+ProcessSamples AxisSamples(const std::vector<CrossingDiscrepancy>& crossings,
+                           const std::vector<bool>& use, int axis) {
+  ProcessSamples samples;
+  for (size_t c = 0; c < crossings.size(); ++c) {
+    if (!use[c]) continue;
+    samples.Add(crossings[c].time_s, crossings[c].value_m[axis],
+                crossings[c].variance_m2[axis]);
+  }
+  return samples;
+}
+
+// Chi-square (3 axes) of crossing `c`'s value, moved by `shift`, against
+// what the other crossings in `use` predict with `fits`.
+double LeaveOneOutChiSquare(const std::vector<CrossingDiscrepancy>& crossings,
+                            const std::vector<bool>& use, int c,
+                            const std::vector<GaussMarkovFit>& fits,
+                            const Eigen::Vector3d& shift) {
+  std::vector<bool> with = use;
+  with[c] = true;
+  // Position of c among the samples of `with`.
+  int position = 0;
+  for (int k = 0; k < c; ++k) position += with[k] ? 1 : 0;
+  double chi_square = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    ProcessSamples samples = AxisSamples(crossings, with, axis);
+    samples.value[position] += shift[axis];
+    const ProcessPrediction p =
+        PredictLeaveOneOut(samples, position, fits[axis]);
+    chi_square += p.standardized * p.standardized;
+  }
+  return chi_square;
+}
+
+}  // namespace
+
+std::vector<CrossingDiscrepancy> CrossingDiscrepancies(
+    const AdjustmentOptions& options, const State& state,
+    const std::vector<Eigen::Vector3d>& period_enu) {
+  const int n = static_cast<int>(period_enu.size());
+  std::vector<std::vector<Eigen::Vector3d>> values(n);
+  std::vector<Eigen::Vector3d> variance_sum(n, Eigen::Vector3d::Zero());
+  std::vector<double> time_sum(n, 0.0);
+  std::vector<Eigen::Matrix3d> R_track_enu(n, Eigen::Matrix3d::Identity());
+  std::vector<int> observations(n, 0);
+  for (const ControlPoint& p : state.points) {
+    if (p.status == ControlStatus::kRejected || p.observations.empty()) {
+      continue;
+    }
+    Eigen::Vector3d X;
+    Eigen::Matrix3d covariance;
+    if (!StereoPosition(options, state, p.stereo, &X, &covariance)) continue;
+    const int c = p.crossing;
+    const Pose& ins = p.observations.front().ins_pose;
+    R_track_enu[c] = state.correction.Frame(ins).transpose();
+    values[c].push_back(R_track_enu[c] * (p.database_enu - X));
+    VLOG(2) << "discrepancy " << p.crossing_id << " band " << p.band
+            << " vertex " << p.db_vertex << ": " << values[c].back().transpose()
+            << " from " << p.stereo.size() << " exposures";
+    const Eigen::Matrix3d database =
+        p.sigma_m.cwiseAbs2().asDiagonal().toDenseMatrix() + covariance;
+    variance_sum[c] +=
+        (R_track_enu[c] * database * R_track_enu[c].transpose()).diagonal();
+    for (const StereoObservation& o : p.stereo) {
+      time_sum[c] += o.time;
+      ++observations[c];
+    }
+  }
+  std::vector<CrossingDiscrepancy> out(n);
+  const double offset2 =
+      options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
+  for (int c = 0; c < n; ++c) {
+    const int m = static_cast<int>(values[c].size());
+    if (m == 0) continue;
+    CrossingDiscrepancy& d = out[c];
+    d.valid = true;
+    d.vertices = m;
+    d.time_s = time_sum[c] / observations[c];
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> v;
+      for (const Eigen::Vector3d& x : values[c]) v.push_back(x[axis]);
+      d.value_m[axis] = Median(v);
+    }
+    // The median of m values has pi/2 times the variance of their mean;
+    // the crossing's offset is common to all of them.
+    d.variance_m2 =
+        Eigen::Vector3d::Constant(offset2) +
+        (kPi / 2.0) * variance_sum[c] / (m * static_cast<double>(m));
+    Eigen::Vector3d period = R_track_enu[c] * period_enu[c];
+    period.z() = 0.0;
+    d.period_m = period;
+    // The jumps taken out of the trajectory before this time are part of
+    // the correction (adjustment_state.h): the process is the rest.
+    if (!state.knot_prior.empty()) {
+      const double dt = state.correction.knot_spacing();
+      const int k = std::clamp(
+          static_cast<int>(
+              std::lround((d.time_s - state.correction.KnotTime(0)) / dt)),
+          0, static_cast<int>(state.knot_prior.size()) - 1);
+      d.value_m -= state.knot_prior[k].tail<3>();
+    }
+  }
+  return out;
+}
+
+std::vector<GaussMarkovFit> FitAxes(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<bool>& use, const GaussMarkovFitOptions& fit_options) {
+  std::vector<GaussMarkovFit> fits;
+  for (int axis = 0; axis < 3; ++axis) {
+    fits.push_back(
+        FitGaussMarkov(AxisSamples(crossings, use, axis), fit_options));
+  }
+  return fits;
+}
+
+std::vector<CrossingVerdict> SelectConsistentCrossings(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<std::string>& names,
+    const GaussMarkovFitOptions& fit_options, double chi_square_threshold) {
+  const int n = static_cast<int>(crossings.size());
+  std::vector<CrossingVerdict> verdicts(n);
+  std::vector<bool> active(n);
+  for (int c = 0; c < n; ++c) active[c] = crossings[c].valid;
+  while (std::count(active.begin(), active.end(), true) >= 2) {
+    const int count =
+        static_cast<int>(std::count(active.begin(), active.end(), true));
+    const std::vector<GaussMarkovFit> all =
+        FitAxes(crossings, active, fit_options);
+    int worst = -1;
+    double worst_chi = 0.0;
+    std::vector<GaussMarkovFit> worst_fits;
+    for (int c = 0; c < n; ++c) {
+      if (!active[c]) continue;
+      // The model is refitted without the crossing tested, so that a
+      // wrong crossing cannot widen it enough to pass.
+      std::vector<bool> others = active;
+      others[c] = false;
+      const std::vector<GaussMarkovFit> fits =
+          count <= kMaxCrossingsForRefit
+              ? FitAxes(crossings, others, fit_options)
+              : all;
+      const double chi = LeaveOneOutChiSquare(crossings, others, c, fits,
+                                              Eigen::Vector3d::Zero());
+      VLOG(1) << "crossing " << names[c] << ": leave-one-out chi-square " << chi
+              << " (" << crossings[c].value_m.transpose() << " m)";
+      if (chi > worst_chi) {
+        worst_chi = chi;
+        worst = c;
+        worst_fits = fits;
+      }
+    }
+    if (worst < 0 || worst_chi <= chi_square_threshold) break;
+    std::vector<bool> others = active;
+    others[worst] = false;
+    CrossingVerdict& verdict = verdicts[worst];
+    verdict.consistent = false;
+    verdict.chi_square = worst_chi;
+    const Eigen::Vector3d& period = crossings[worst].period_m;
+    if (period.norm() > 0.0) {
+      for (double sign : {-1.0, 1.0}) {
+        const double shifted = LeaveOneOutChiSquare(crossings, others, worst,
+                                                    worst_fits, sign * period);
+        if (shifted <= chi_square_threshold) verdict.one_period_off = true;
+      }
+    }
+    const Eigen::Vector3d& d = crossings[worst].value_m;
+    verdict.reason =
+        "crossing " + names[worst] +
+        " implies a trajectory correction (along-track " + Fixed(d.x(), 2) +
+        " m, cross-track " + Fixed(d.y(), 2) + " m, up " + Fixed(d.z(), 2) +
+        " m) that the other crossings and the GNSS/INS error "
+        "model do not explain (chi-square " +
+        Fixed(worst_chi, 1) + " > " + Fixed(chi_square_threshold, 1) + ")";
+    if (verdict.one_period_off) {
+      verdict.reason += "; shifted by one band period (" +
+                        Fixed(period.norm(), 2) +
+                        " m) it would fit: matched one band off";
+    } else {
+      verdict.reason += ": repainted, or wrongly matched";
+    }
+    active[worst] = false;
+  }
+  return verdicts;
+}
+
+}  // namespace adjustment_internal
+}  // namespace zebrageo

@@ -1,0 +1,69 @@
+// Internal to the trajectory adjustment: which matched crossings may serve
+// as control. Each crossing's discrepancy (database minus image-only
+// position with the INS trajectory: the trajectory's error there plus the
+// database's) is tested against what the other crossings and the GNSS/INS
+// error model (error_model.h) predict at its time. The worst crossing that
+// fails is removed and the test repeated, so that the largest consistent
+// set remains: one repainted or wrongly matched crossing costs itself, not
+// the control of the whole survey. A crossing that would fit once shifted
+// by one band period across the crossing was matched one band off: it is
+// named as such.
+//
+// Frames: discrepancies in the track frame at the crossing (along-track,
+// left, up), metres.
+#ifndef ZEBRAGEO_ADJUSTMENT_CONTROL_SELECTION_H_
+#define ZEBRAGEO_ADJUSTMENT_CONTROL_SELECTION_H_
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "adjustment/adjustment_state.h"
+#include "adjustment/error_model.h"
+
+namespace zebrageo {
+namespace adjustment_internal {
+
+struct CrossingDiscrepancy {
+  bool valid = false;  // at least one vertex could be triangulated
+  double time_s = 0.0;
+  Eigen::Vector3d value_m = Eigen::Vector3d::Zero();      // track frame
+  Eigen::Vector3d variance_m2 = Eigen::Vector3d::Zero();  // per axis
+  // One band period across the crossing (track frame, horizontal).
+  Eigen::Vector3d period_m = Eigen::Vector3d::Zero();
+  int vertices = 0;
+};
+
+// Per crossing (index of ControlPoint::crossing), from the control and
+// check points of `state` triangulated with its current correction (zero:
+// the de-jumped INS trajectory; the jumps of knot_prior are added back).
+// `period_enu` is each crossing's band period vector in ENU (zero when
+// unknown).
+std::vector<CrossingDiscrepancy> CrossingDiscrepancies(
+    const AdjustmentOptions& options, const State& state,
+    const std::vector<Eigen::Vector3d>& period_enu);
+
+struct CrossingVerdict {
+  bool consistent = true;
+  bool one_period_off = false;
+  double chi_square = 0.0;  // of its leave-one-out test when it failed
+  std::string reason;
+};
+
+// The verdict per crossing. Crossings without a valid discrepancy are left
+// consistent (untested). `names` label the reasons.
+std::vector<CrossingVerdict> SelectConsistentCrossings(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<std::string>& names,
+    const GaussMarkovFitOptions& fit_options, double chi_square_threshold);
+
+// The Gauss-Markov fit of each axis (along, cross, up) of the crossings
+// flagged in `use`.
+std::vector<GaussMarkovFit> FitAxes(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<bool>& use, const GaussMarkovFitOptions& fit_options);
+
+}  // namespace adjustment_internal
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_ADJUSTMENT_CONTROL_SELECTION_H_

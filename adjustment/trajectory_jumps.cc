@@ -1,0 +1,123 @@
+#include "adjustment/trajectory_jumps.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace zebrageo {
+
+DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
+                               double threshold_rad) {
+  const std::vector<Pose>& poses = trajectory.poses();
+  const int n = static_cast<int>(poses.size());
+  DejumpedTrajectory out;
+  out.poses = poses;
+  out.position_offset.assign(n, Eigen::Vector3d::Zero());
+  out.rotation_offset.assign(n, Eigen::Quaterniond::Identity());
+  if (n < 8 || (threshold_m <= 0.0 && threshold_rad <= 0.0)) return out;
+  const std::vector<TrajectorySample>& samples = trajectory.samples();
+  // Steps per second (velocity, angular rate in the body frame).
+  std::vector<Eigen::Vector3d> velocity(n, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> rate(n, Eigen::Vector3d::Zero());
+  for (int i = 1; i < n; ++i) {
+    const double dt = samples[i].time - samples[i - 1].time;
+    velocity[i] = (poses[i].p_enu - poses[i - 1].p_enu) / dt;
+    const Eigen::AngleAxisd step(poses[i - 1].q_enu_body.inverse() *
+                                 poses[i].q_enu_body);
+    rate[i] = step.angle() * step.axis() / dt;
+  }
+  auto median_of_neighbours = [&](const std::vector<Eigen::Vector3d>& v,
+                                  int i) {
+    Eigen::Vector3d m;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> values;
+      for (int k = std::max(1, i - 3); k <= std::min(n - 1, i + 3); ++k) {
+        if (k != i) values.push_back(v[k][axis]);
+      }
+      std::nth_element(values.begin(), values.begin() + values.size() / 2,
+                       values.end());
+      m[axis] = values[values.size() / 2];
+    }
+    return m;
+  };
+  // Departure of each step from its neighbours' motion. A step across a
+  // gap of the trajectory (survey/trajectory.h) is not one: the vehicle's
+  // motion during the gap is unknown, so it is never taken for a jump.
+  std::vector<bool> across_gap(n, false);
+  for (const TrajectoryGap& gap : FindTrajectoryGaps(SampleTimes(samples))) {
+    across_gap[gap.before + 1] = true;
+  }
+  std::vector<Eigen::Vector3d> position_step(n, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> rotation_step(n, Eigen::Vector3d::Zero());
+  for (int i = 1; i < n; ++i) {
+    if (across_gap[i]) continue;
+    const double dt = samples[i].time - samples[i - 1].time;
+    position_step[i] = (velocity[i] - median_of_neighbours(velocity, i)) * dt;
+    rotation_step[i] = (rate[i] - median_of_neighbours(rate, i)) * dt;
+  }
+  // A jump stands out of the trajectory's own motion: at 10 Hz the body's
+  // oscillations on its suspension (a tenth of a degree at 1-2 Hz) depart
+  // from the neighbouring steps by more than a 100 Hz trajectory's do, and
+  // are not jumps. The thresholds are raised to kJumpNoiseFactor times the
+  // median departure when that is larger.
+  constexpr double kJumpNoiseFactor = 8.0;
+  auto median_norm = [&](const std::vector<Eigen::Vector3d>& steps) {
+    std::vector<double> norms;
+    for (int i = 1; i < n; ++i) norms.push_back(steps[i].norm());
+    std::nth_element(norms.begin(), norms.begin() + norms.size() / 2,
+                     norms.end());
+    return norms[norms.size() / 2];
+  };
+  threshold_m =
+      threshold_m > 0.0
+          ? std::max(threshold_m, kJumpNoiseFactor * median_norm(position_step))
+          : 0.0;
+  threshold_rad = threshold_rad > 0.0
+                      ? std::max(threshold_rad,
+                                 kJumpNoiseFactor * median_norm(rotation_step))
+                      : 0.0;
+  Eigen::Vector3d position_jump = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation_jump = Eigen::Quaterniond::Identity();
+  for (int i = 1; i < n; ++i) {
+    bool jumped = false;
+    if (threshold_m > 0.0) {
+      const Eigen::Vector3d& step = position_step[i];
+      if (step.norm() > threshold_m) {
+        position_jump += step;
+        jumped = true;
+      }
+    }
+    if (threshold_rad > 0.0) {
+      const Eigen::Vector3d& step = rotation_step[i];
+      if (step.norm() > threshold_rad) {
+        // In the ENU frame: R_i = J R_i', J = R_{i-1} Exp(step) R_{i-1}^T.
+        const Eigen::Quaterniond body_step(
+            Eigen::AngleAxisd(step.norm(), step.normalized()));
+        const Eigen::Quaterniond J = poses[i - 1].q_enu_body * body_step *
+                                     poses[i - 1].q_enu_body.inverse();
+        rotation_jump = (J * rotation_jump).normalized();
+        jumped = true;
+      }
+    }
+    out.num_jumps += jumped;
+    out.position_offset[i] = position_jump;
+    out.rotation_offset[i] = rotation_jump;
+    out.poses[i].p_enu = poses[i].p_enu - position_jump;
+    out.poses[i].q_enu_body =
+        (rotation_jump.inverse() * poses[i].q_enu_body).normalized();
+  }
+  return out;
+}
+
+bool InterpolateDejumped(const Trajectory& trajectory,
+                         const DejumpedTrajectory& dejumped, double time,
+                         Pose* pose) {
+  const int i = trajectory.FindSegment(time);
+  if (i < 0) return false;
+  const double t0 = trajectory.samples()[i].time;
+  const double t1 = trajectory.samples()[i + 1].time;
+  *pose = InterpolatePoses(dejumped.poses[i], dejumped.poses[i + 1],
+                           (time - t0) / (t1 - t0));
+  return true;
+}
+
+}  // namespace zebrageo
