@@ -9,6 +9,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "reconstruction/crossing_regularity.h"
 #include "reconstruction/road_plane.h"
 
 namespace zebrageo {
@@ -212,6 +213,29 @@ Eigen::Vector3d OnBandPlane(const PlaneFrame& frame, const RoadPlane& plane,
   return p - plane.SignedDistance(p) / denominator * frame.normal;
 }
 
+// Unit normal, in rectified image `side`, of the line of the band plane
+// through the centre of `area_3d` along `direction_2d` (plane frame),
+// oriented like `like`.
+Eigen::Vector2d ImageNormalOf(const RoadRectification& rectification, int side,
+                              const PlaneFrame& frame, const RoadPlane& plane,
+                              const std::array<Eigen::Vector3d, 4>& area_3d,
+                              const Eigen::Vector2d& direction_2d,
+                              const Eigen::Vector2d& like) {
+  const Eigen::Vector3d centre =
+      0.25 * (area_3d[0] + area_3d[1] + area_3d[2] + area_3d[3]);
+  const Eigen::Vector3d ahead =
+      OnBandPlane(frame, plane, frame.To2d(centre) + 0.5 * direction_2d);
+  Eigen::Vector2d a, b;
+  if (!rectification.ProjectToRectified(side, centre, &a) ||
+      !rectification.ProjectToRectified(side, ahead, &b)) {
+    return like;
+  }
+  const Eigen::Vector2d d = (b - a).normalized();
+  Eigen::Vector2d normal(-d.y(), d.x());
+  if (normal.dot(like) < 0.0) normal = -normal;
+  return normal;
+}
+
 // Least-squares plane of a band and the variance of its height at a point:
 // z = a x + b y + c in the band's own frame (x along, y across, z normal).
 struct BandPlaneFit {
@@ -254,6 +278,25 @@ bool FitBandPlane(const std::vector<Eigen::Vector3d>& points,
   return true;
 }
 
+// FitBandPlane, then again without the points more than 3 rms (at least
+// 1 cm) off the plane (mismatched edge points).
+bool FitRobustBandPlane(std::vector<Eigen::Vector3d> points,
+                        const Eigen::Vector3d& along,
+                        const Eigen::Vector3d& normal, double min_sigma_m,
+                        BandPlaneFit* fit) {
+  if (!FitBandPlane(points, along, normal, min_sigma_m, fit)) return false;
+  const double limit = std::max(0.01, 3.0 * fit->rms_m);
+  const size_t before = points.size();
+  points.erase(std::remove_if(points.begin(), points.end(),
+                              [&](const Eigen::Vector3d& p) {
+                                return std::abs(fit->plane.SignedDistance(p)) >
+                                       limit;
+                              }),
+               points.end());
+  if (points.size() == before) return true;
+  return FitBandPlane(points, along, normal, min_sigma_m, fit);
+}
+
 struct BandCandidate {
   int lo = -1;  // side with the smaller lateral coordinate
   int hi = -1;
@@ -278,6 +321,10 @@ struct KnownEnd {
   // For the seen end of such a band: the crossing's line there, to choose
   // among the candidates (what hides the other end may have edges too).
   const PlaneLine* expected = nullptr;
+  // The crossing's direction of the transversal sides (plane frame): a seen
+  // end is fitted with it (only its offset), once its own direction is
+  // found within max_end_angle_rad of it.
+  const Eigen::Vector2d* direction = nullptr;
 };
 
 // kNoTransversal: no transversal side at an end; kDisagreement: the two
@@ -305,6 +352,47 @@ void Extent(const PlaneFrame& frame, const LongSide& side,
   *high = std::max(a, b);
 }
 
+// `side` fitted again on its points within `margin_m` of the band's extent
+// [begin_m, end_m] along its set's direction, when it runs on beyond that
+// by more than margin_m and at least half of its points are within.
+LongSide SideAlongBand(const std::vector<EdgePoint3d>& points,
+                       const PlaneFrame& frame, const LongSide& side,
+                       double begin_m, double end_m, double margin_m) {
+  double low, high;
+  Extent(frame, side, side.direction_2d, &low, &high);
+  if (low >= begin_m - margin_m && high <= end_m + margin_m) return side;
+  std::vector<int> within;
+  for (int p : side.support) {
+    const double t = frame.To2d(points[p].p_chain_body).dot(side.direction_2d);
+    if (t >= begin_m - margin_m && t <= end_m + margin_m) within.push_back(p);
+  }
+  if (2 * within.size() < side.support.size() || within.size() < 10) {
+    return side;
+  }
+  return FitLongSide(points, std::move(within), frame, side.direction_2d,
+                     side.direction_set);
+}
+
+// Least-squares line y = a + b x through the points (p[0], p[index]):
+// {a, b}; b = 0 when the x spread is below 1 cm.
+std::array<double, 2> LinearFit(const std::vector<std::array<double, 3>>& p,
+                                int index) {
+  double mean_x = 0.0, mean_y = 0.0;
+  for (const auto& q : p) {
+    mean_x += q[0];
+    mean_y += q[index];
+  }
+  mean_x /= static_cast<double>(p.size());
+  mean_y /= static_cast<double>(p.size());
+  double sxx = 0.0, sxy = 0.0;
+  for (const auto& q : p) {
+    sxx += (q[0] - mean_x) * (q[0] - mean_x);
+    sxy += (q[0] - mean_x) * (q[index] - mean_y);
+  }
+  const double b = sxx > 1e-4 * static_cast<double>(p.size()) ? sxy / sxx : 0.0;
+  return {mean_y - b * mean_x, b};
+}
+
 // Completes the crossings: a long side that no band took, lying where the
 // crossing's regular pattern expects a band side (one band width from the
 // slot of a missing band, with the polarity of that side), becomes a band
@@ -323,7 +411,8 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
   const int n = static_cast<int>(side_used.size());
   const int m = static_cast<int>(pairs->size());
   for (int c = 0; c < crossings; ++c) {
-    std::vector<double> centres, widths, contrasts, begins, ends;
+    std::vector<double> centres, widths, contrasts, lengths;
+    std::vector<std::array<double, 3>> extents;  // (centre, begin, end)
     int set = -1;
     Eigen::Vector3d direction_body = Eigen::Vector3d::Zero();
     Eigen::Vector2d along = Eigen::Vector2d::UnitX();
@@ -332,11 +421,12 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
       const LongSide& lo = (*sides)[(*pairs)[i].lo];
       const LongSide& hi = (*sides)[(*pairs)[i].hi];
       centres.push_back(0.5 * (lo.lateral_m + hi.lateral_m));
+      extents.push_back({centres.back(), (*pairs)[i].begin, (*pairs)[i].end});
       widths.push_back(hi.lateral_m - lo.lateral_m);
       contrasts.push_back(std::abs(lo.contrast));
       contrasts.push_back(std::abs(hi.contrast));
-      begins.push_back((*pairs)[i].begin);
-      ends.push_back((*pairs)[i].end);
+      lengths.push_back(lo.Length());
+      lengths.push_back(hi.Length());
       set = lo.direction_set;
       direction_body = lo.direction_body;
       along = lo.direction_2d;
@@ -374,8 +464,10 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
           irregular || std::abs(d - period) > options.completion_tolerance_m;
     }
     if (irregular) continue;
-    const double begin = MedianOf(begins);
-    const double end = MedianOf(ends);
+    // A skewed crossing's bands are offset along the band: its ends are
+    // lines across the bands, begin and end linear in the lateral position.
+    const std::array<double, 2> begin_line = LinearFit(extents, 1);
+    const std::array<double, 2> end_line = LinearFit(extents, 2);
     const double min_contrast = 0.5 * MedianOf(contrasts);
     // Best side for each empty slot (index from the first band).
     std::map<int, std::pair<double, int>> best;  // slot -> (residual, side)
@@ -388,18 +480,21 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
         continue;
       }
       if (std::abs(s.contrast) < min_contrast) continue;
-      // Within the crossing along the band, and no longer than its bands (a
-      // lane line is).
+      // Paint brightens towards +lateral at the low side of a band.
+      const double centre =
+          s.lateral_m + (s.contrast > 0.0 ? 0.5 : -0.5) * width;
+      // Within the crossing along the band, and no longer than its bands'
+      // sides (a lane line is; a side is longer than its band's overlap
+      // with the other side).
+      const double begin = begin_line[0] + begin_line[1] * centre;
+      const double end = end_line[0] + end_line[1] * centre;
       double s0, s1;
       Extent(frame, s, along, &s0, &s1);
-      if (s1 - s0 > end - begin + options.completion_tolerance_m * 5.0 ||
+      if (s1 - s0 > MedianOf(lengths) + options.completion_tolerance_m * 5.0 ||
           std::min(s1, end) - std::max(s0, begin) <
               options.min_side_overlap_fraction * (s1 - s0)) {
         continue;
       }
-      // Paint brightens towards +lateral at the low side of a band.
-      const double centre =
-          s.lateral_m + (s.contrast > 0.0 ? 0.5 : -0.5) * width;
       const double position = (centre - centres.front()) / period;
       const int slot = static_cast<int>(std::lround(position));
       const double residual = std::abs(position - slot) * period;
@@ -559,6 +654,12 @@ std::string BandOptions::Check() const {
   } else if (!(hidden_end_max_offset_m > 0.0)) {
     error << "hidden_end_max_offset_m = " << hidden_end_max_offset_m
           << ": must be > 0";
+  } else if (!(max_length_excess_m >= 0.0)) {
+    error << "max_length_excess_m = " << max_length_excess_m
+          << ": must be >= 0";
+  } else if (min_end_direction_observations < 2) {
+    error << "min_end_direction_observations = "
+          << min_end_direction_observations << ": must be >= 2";
   }
   return error.str();
 }
@@ -683,7 +784,8 @@ bool ChooseTransversalPair(const std::vector<ImageLine>& begin,
 }
 
 bool RefineImageLine(const EdgeMap& edges, const Area& area,
-                     const BandOptions& options, ImageLine* line) {
+                     const BandOptions& options, ImageLine* line,
+                     const Eigen::Vector2d* fixed_normal) {
   // Sub-pixel edge positions along the line: at every pixel step along it,
   // the centroid of the gradient profile across it (the gradient projected
   // on the line's polarity, over the contiguous part above a third of its
@@ -768,7 +870,10 @@ bool RefineImageLine(const EdgeMap& edges, const Area& area,
         scatter += weights[k] * d * d.transpose();
       }
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
-      Eigen::Vector2d normal = solver.eigenvectors().col(0);
+      Eigen::Vector2d normal =
+          fixed_normal != nullptr
+              ? *fixed_normal
+              : Eigen::Vector2d(solver.eigenvectors().col(0));
       if (normal.dot(current.normal) < 0.0) normal = -normal;
       current.normal = normal;
       current.rho = normal.dot(mean);
@@ -907,6 +1012,13 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
           options.min_side_overlap_fraction * std::min(a1 - a0, b1 - b0)) {
         continue;
       }
+      // Longer than any band: the inner edge of a lane line and a kerb, or
+      // a lane line's two edges and a gutter, running along the crossing.
+      // Taken as one of its bands it would set the crossing's ends (the
+      // extremities of its longest bands) far from the painted ones.
+      if (overlap > zebra.max_band_length_m + options.max_length_excess_m) {
+        continue;
+      }
       // The paint is one band: no gap of asphalt between the two sides, i.e.
       // no side where the paint ends (darkening) followed by one where it
       // starts again (a side paired with the far edge of a lane line next
@@ -1003,10 +1115,14 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       const double b_hi = sides[pairs[j].hi].lateral_m;
       const double gap = std::max(b_lo.lateral_m - a_hi, a_lo.lateral_m - b_hi);
       if (gap > options.max_crossing_gap_m) continue;
-      double a0, a1, b0, b1;
-      Extent(frame, a_lo, a_lo.direction_2d, &a0, &a1);
-      Extent(frame, b_lo, a_lo.direction_2d, &b0, &b1);
-      if (std::min(a1, b1) - std::max(a0, b0) <= 0.0) continue;
+      // The bands themselves overlap along their direction, not only
+      // their sides: a side may run on along a lane line, and a pair of
+      // lines before the crossing would join it and set its ends.
+      if (std::min(pairs[i].end, pairs[j].end) -
+              std::max(pairs[i].begin, pairs[j].begin) <=
+          0.0) {
+        continue;
+      }
       parent[Root(&parent, i)] = Root(&parent, j);
     }
   }
@@ -1034,12 +1150,16 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
 
   // 3. Approximate transversal sides of each crossing: regression on the
   // extremities of its longer long sides (seen bands only).
-  for (int i = 0; i < m; ++i) {
+  for (int i = 0; i < m_all && VLOG_IS_ON(2); ++i) {
+    const LongSide& lo = sides[pairs[i].lo];
+    const Eigen::Vector3d centre_body = frame.To3d(
+        0.5 * (pairs[i].begin + pairs[i].end) * lo.direction_2d +
+        0.5 * (lo.lateral_m + sides[pairs[i].hi].lateral_m) * lo.Normal2d());
     VLOG(2) << "band " << i << ": sides " << pairs[i].lo << " " << pairs[i].hi
-            << " set " << sides[pairs[i].lo].direction_set << " lateral "
-            << sides[pairs[i].lo].lateral_m << " "
+            << " set " << lo.direction_set << " lateral " << lo.lateral_m << " "
             << sides[pairs[i].hi].lateral_m << " extent " << pairs[i].begin
-            << " " << pairs[i].end << " crossing " << crossing_of[i];
+            << " " << pairs[i].end << " crossing " << crossing_of[i]
+            << " centre_body " << centre_body.transpose();
   }
   std::vector<PlaneLine> begin_lines(crossings), end_lines(crossings);
   for (int c = 0; c < crossings; ++c) {
@@ -1077,21 +1197,42 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   // 4. Each band: plane, transversal sides, vertices. `known[e]`: the
   // transversal side of end e is not searched but taken from that line of
   // the plane frame (a hidden end, see below).
+  // Directions of the band ends seen in the first pass (step 4b).
+  std::vector<EndDirectionObservation>* end_directions = nullptr;
   auto model_band = [&](int i, const KnownEnd known[2],
                         Band* out) -> BandOutcome {
-    const LongSide& lo = sides[pairs[i].lo];
-    const LongSide& hi = sides[pairs[i].hi];
+    // A seen side that runs on beyond the band (into a lane line, a
+    // vehicle's shadow edge, within the grouping's 3 cm) is fitted again
+    // on its points along the band: what it runs on to tilts its line.
+    LongSide lo = sides[pairs[i].lo];
+    LongSide hi = sides[pairs[i].hi];
+    if (pairs[i].inferred < 0) {
+      lo = SideAlongBand(detection.points, frame, lo, pairs[i].begin,
+                         pairs[i].end, options.transversal_search_m);
+      hi = SideAlongBand(detection.points, frame, hi, pairs[i].begin,
+                         pairs[i].end, options.transversal_search_m);
+    }
     const Eigen::Vector2d along = lo.direction_2d;
     const Eigen::Vector2d across = lo.Normal2d();
+    // The band plane from its sides' points along the band only: a side
+    // may run on beyond it (along a lane line, a vehicle's shadow), and
+    // what it runs on to may not lie on the road (a 3 cm height rms tilted
+    // a band's plane by 2 degrees and moved its ends 20 cm out, sim08).
     std::vector<Eigen::Vector3d> support;
-    for (int s : {pairs[i].lo, pairs[i].hi}) {
-      for (int p : sides[s].support) {
+    for (const LongSide* side : {&lo, &hi}) {
+      for (int p : side->support) {
+        const double t =
+            frame.To2d(detection.points[p].p_chain_body).dot(along);
+        if (t < pairs[i].begin - options.transversal_search_m ||
+            t > pairs[i].end + options.transversal_search_m) {
+          continue;
+        }
         support.push_back(detection.points[p].p_body);
       }
     }
     BandPlaneFit plane_fit;
-    if (!FitBandPlane(support, lo.direction_body, frame.normal,
-                      options.min_sigma_m, &plane_fit)) {
+    if (!FitRobustBandPlane(support, lo.direction_body, frame.normal,
+                            options.min_sigma_m, &plane_fit)) {
       return BandOutcome::kRejected;
     }
     const RoadPlane& plane = plane_fit.plane;
@@ -1131,6 +1272,9 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     vertex_sum.fill(Eigen::Vector3d::Zero());
     std::array<std::array<Eigen::Vector3d, 4>, 2> vertex_side;
     double line_sigma_px[2][2] = {{0, 0}, {0, 0}};
+    // Signed angle of each image's own end (free fit) from the crossing's
+    // direction of the ends, when it is known.
+    double free_angle[2][2] = {{0, 0}, {0, 0}};
     double contrast = 0.0;
     int views = 0;
     bool failed = false;
@@ -1275,6 +1419,21 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                   << ": refinement failed";
           break;
         }
+        if (known[e].direction != nullptr) {
+          // The crossing's direction in this image, at this end.
+          const Eigen::Vector2d normal =
+              ImageNormalOf(rectification, side, frame, plane, areas_3d[e],
+                            *known[e].direction, transversal_lines[e].normal);
+          const Eigen::Vector2d& own = transversal_lines[e].normal;
+          free_angle[side][e] = std::atan2(Cross(normal, own), normal.dot(own));
+          VLOG(2) << "band " << i << " side " << side << " end " << e << ": "
+                  << free_angle[side][e] << " rad from the crossing's ends";
+          if (!RefineImageLine(edges[side], areas[e], options,
+                               &transversal_lines[e], &normal)) {
+            failed = transversal_failed = true;
+            break;
+          }
+        }
         line_sigma_px[side][e] = std::max(
             options.min_line_sigma_px,
             transversal_lines[e].rms_px /
@@ -1384,6 +1543,19 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       return transversal_failed ? BandOutcome::kNoTransversal
                                 : BandOutcome::kRejected;
     }
+    // A painted end is parallel to its crossing's (a stain's slanted edge
+    // cutting the paint is not): each end's own direction, averaged over
+    // the two images (a far end's angle is noisy in each), within
+    // max_end_angle_rad of the crossing's.
+    for (int e = 0; e < 2; ++e) {
+      if (known[e].direction == nullptr || known[e].line != nullptr) continue;
+      const double angle = 0.5 * (free_angle[0][e] + free_angle[1][e]);
+      if (!(std::abs(angle) <= options.max_end_angle_rad)) {
+        VLOG(2) << "band " << i << " end " << e << ": " << angle
+                << " rad from the crossing's ends";
+        return BandOutcome::kRejected;
+      }
+    }
 
     Band band;
     band.plane = plane;
@@ -1397,6 +1569,11 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                               (vertex_side[0][v] - vertex_side[1][v]).norm());
     }
     band.stereo_disagreement_m = disagreement;
+    for (int v = 0; v < 4; ++v) {
+      VLOG(3) << "band " << i << " vertex " << v << " left "
+              << vertex_side[0][v].transpose() << " right "
+              << vertex_side[1][v].transpose();
+    }
     const Eigen::Vector3d band_middle =
         0.25 * (band.vertices_body[0] + band.vertices_body[1] +
                 band.vertices_body[2] + band.vertices_body[3]);
@@ -1415,6 +1592,21 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       VLOG(2) << "band " << i << ": extrapolated at range " << range;
       return BandOutcome::kRejected;
     }
+    if (end_directions != nullptr && !extrapolated) {
+      // Each image's two ends, weighted by their angular precision: the
+      // along-band error of an end grows with the square of its range.
+      for (int side = 0; side < 2; ++side) {
+        for (int e = 0; e < 2; ++e) {
+          const Eigen::Vector3d& a = vertex_side[side][e == 0 ? 0 : 3];
+          const Eigen::Vector3d& b = vertex_side[side][e == 0 ? 1 : 2];
+          const double r =
+              (0.5 * (a + b) - rectification.left_centre_body()).norm();
+          end_directions->push_back(
+              {crossing, (frame.To2d(b) - frame.To2d(a)).normalized(),
+               1.0 / std::pow(std::max(r, 1.0), 4)});
+        }
+      }
+    }
     if (disagreement > options.max_stereo_disagreement_m) {
       VLOG(2) << "band " << i << ": stereo disagreement " << disagreement;
       return BandOutcome::kDisagreement;
@@ -1427,7 +1619,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     band.width_m = 0.5 * ((v1 - v0).norm() + (v2 - v3).norm()) *
                    std::abs(plane_fit.y_axis.dot((v1 - v0).normalized()));
     if (band.length_m < zebra.min_band_length_m - 0.5 ||
-        band.length_m > zebra.max_band_length_m + 0.5) {
+        band.length_m > zebra.max_band_length_m + options.max_length_excess_m) {
       VLOG(2) << "band " << i << ": length " << band.length_m;
       return BandOutcome::kRejected;
     }
@@ -1501,10 +1693,36 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
 
   std::vector<Band> bands;
   std::vector<int> without_transversal;
+  std::vector<EndDirectionObservation> observations;
+  end_directions = options.crossing_end_direction ? &observations : nullptr;
   const KnownEnd none[2];
+  std::vector<BandOutcome> outcomes(m_all);
+  std::vector<Band> first(m_all);
+  for (int i = 0; i < m_all; ++i) outcomes[i] = model_band(i, none, &first[i]);
+  end_directions = nullptr;
+  // 4b. The ends of a crossing's bands are parallel: the direction of its
+  // ends, from every band seen in both images and weighted by range, is
+  // far more precise than a far band's own (a 0.5 m end at 15 m spans a
+  // few original pixels: its angle is noisy, and its two vertices move
+  // apart, one forward, one back). Each band is modelled again with its
+  // ends fitted along that direction.
+  std::vector<Eigen::Vector2d> crossing_direction(crossings);
+  std::vector<char> has_direction(crossings, 0);
+  for (int c = 0; c < crossings && options.crossing_end_direction; ++c) {
+    has_direction[c] = CrossingEndDirection(
+        observations, c, options.min_end_direction_observations,
+        &crossing_direction[c]);
+  }
   for (int i = 0; i < m_all; ++i) {
-    Band band;
-    const BandOutcome outcome = model_band(i, none, &band);
+    Band band = first[i];
+    BandOutcome outcome = outcomes[i];
+    if (has_direction[crossing_of[i]]) {
+      KnownEnd along_crossing[2];
+      for (KnownEnd& k : along_crossing) {
+        k.direction = &crossing_direction[crossing_of[i]];
+      }
+      outcome = model_band(i, along_crossing, &band);
+    }
     if (outcome == BandOutcome::kBand) bands.push_back(band);
     if (outcome == BandOutcome::kNoTransversal ||
         outcome == BandOutcome::kDisagreement) {
@@ -1579,6 +1797,7 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       known[e].line = &lines[c][e];
       known[e].sigma_m = line_sigma[c][e];
       known[1 - e].expected = &lines[c][1 - e];
+      if (has_direction[c]) known[1 - e].direction = &crossing_direction[c];
       Band band;
       if (model_band(i, known, &band) != BandOutcome::kBand) continue;
       // The seen end on the crossing's line of that end.

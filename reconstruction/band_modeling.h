@@ -25,8 +25,12 @@ namespace zebrageo {
 struct BandOptions {
   // Long sides of one band are parallel within this angle.
   double max_side_angle_rad = 0.05;
-  // They overlap (along the band) over at least this share of the shorter.
+  // They overlap (along the band) over at least this share of the shorter,
+  // and over at most ZebraSpecification::max_band_length_m plus this: a
+  // longer pair is no band (a lane line's edge and the kerb beside a
+  // crossing).
   double min_side_overlap_fraction = 0.5;
+  double max_length_excess_m = 0.5;
   // The approximate transversal sides of a crossing come from the ends of
   // its long sides at least this share of the longest (the paper's 80 %).
   double extremity_length_fraction = 0.8;
@@ -120,6 +124,16 @@ struct BandOptions {
   bool infer_hidden_ends = true;
   double hidden_end_max_rms_m = 0.01;
   double hidden_end_max_offset_m = 0.03;
+  // The ends of a crossing's bands are parallel: their direction is taken
+  // as the weighted median (weights 1 / range^4) of the ends of its bands
+  // seen in both images, when there are at least
+  // min_end_direction_observations of them (two per band and image), and
+  // every seen end is then fitted along it (only its offset), once its own
+  // direction is within max_end_angle_rad of it. At 15 m a band's end
+  // spans a few original pixels and its angle is noisy: its two vertices
+  // move apart along the band, one forward, one back.
+  bool crossing_end_direction = true;
+  int min_end_direction_observations = 4;
 
   std::string Check() const;
 };
@@ -164,9 +178,12 @@ bool ChooseTransversalPair(const std::vector<ImageLine>& begin,
 // Sub-pixel refinement of `line` inside `area`: centroids of the gradient
 // profiles across it (polarity of its gamma) fitted by weighted least
 // squares. False with fewer than min_transversal_points profiles.
+// `fixed_normal` (unit, may be null): the line keeps that normal and only
+// its offset is fitted (the crossing's direction of the band ends).
 bool RefineImageLine(const EdgeMap& edges,
                      const std::array<Eigen::Vector2d, 4>& area,
-                     const BandOptions& options, ImageLine* line);
+                     const BandOptions& options, ImageLine* line,
+                     const Eigen::Vector2d* fixed_normal = nullptr);
 
 // How far a transversal side runs on beyond its band: the mean gradient
 // across `line` (with the polarity of its gamma) beyond the band's long

@@ -38,6 +38,9 @@ struct Group {
   double t_min = 0.0;  // extent along direction from centre
   double t_max = 0.0;
   double rms_m = 0.0;  // perpendicular residuals
+  // +1 when the image brightens across the group towards the left of
+  // `axis`, -1 the other way: one edge of a paint mark keeps its polarity.
+  int polarity = 1;
   double Length() const { return t_max - t_min; }
   Eigen::Vector2d Begin() const { return centre + t_min * direction; }
   Eigen::Vector2d End() const { return centre + t_max * direction; }
@@ -95,6 +98,9 @@ std::vector<Group> MergeCollinear(const std::vector<Eigen::Vector2d>& points,
       for (int j = i + 1; j < n; ++j) {
         const Group& a = groups[i];
         const Group& b = groups[j];
+        // A band's side running on into a lane line's opposite edge, or a
+        // shadow boundary, collinear with it is not one line.
+        if (a.polarity != b.polarity) continue;
         const double angle =
             std::acos(std::min(1.0, std::abs(a.direction.dot(b.direction))));
         // A short group's direction is uncertain: its angle may exceed the
@@ -134,6 +140,7 @@ std::vector<Group> MergeCollinear(const std::vector<Eigen::Vector2d>& points,
       support.insert(support.end(), groups[link.j].support.begin(),
                      groups[link.j].support.end());
       Group joined = MakeGroup(points, std::move(support), axis);
+      joined.polarity = groups[link.i].polarity;
       if (joined.rms_m > limits.max_offset_m) continue;
       touched[link.i] = touched[link.j] = 1;
       next.push_back(std::move(joined));
@@ -205,8 +212,82 @@ std::string LongSideOptions::Check() const {
   } else if (!(min_long_side_length_m > 0.0)) {
     error << "min_long_side_length_m = " << min_long_side_length_m
           << ": must be > 0";
+  } else if (height_smoothing_half_window < 0) {
+    error << "height_smoothing_half_window = " << height_smoothing_half_window
+          << ": must be >= 0";
   }
   return error.str();
+}
+
+void RegulariseChainHeights(const RoadPlane& road,
+                            const Eigen::Vector3d& left_centre_body,
+                            int half_window, EdgeChain3d* chain) {
+  std::vector<EdgePoint3d>& points = chain->points;
+  const int n = static_cast<int>(points.size());
+  for (EdgePoint3d& p : points) p.p_chain_body = p.p_body;
+  if (half_window <= 0 || n < 3) return;
+  std::vector<double> height(n), smooth(n);
+  for (int i = 0; i < n; ++i) height[i] = road.SignedDistance(points[i].p_body);
+  std::vector<char> use(n, 1);
+  // Two pointers over the window; sums of 1, u, u^2, h, u h of the used
+  // points (u relative to the chain's first point).
+  auto fit = [&]() {
+    const int u0 = points[0].index_in_chain;
+    double s0 = 0, su = 0, suu = 0, sh = 0, suh = 0;
+    int lo = 0, hi = 0;  // window [lo, hi)
+    for (int i = 0; i < n; ++i) {
+      const int ui = points[i].index_in_chain;
+      while (hi < n && points[hi].index_in_chain <= ui + half_window) {
+        if (use[hi]) {
+          const double u = points[hi].index_in_chain - u0;
+          s0 += 1.0;
+          su += u;
+          suu += u * u;
+          sh += height[hi];
+          suh += u * height[hi];
+        }
+        ++hi;
+      }
+      while (points[lo].index_in_chain < ui - half_window) {
+        if (use[lo]) {
+          const double u = points[lo].index_in_chain - u0;
+          s0 -= 1.0;
+          su -= u;
+          suu -= u * u;
+          sh -= height[lo];
+          suh -= u * height[lo];
+        }
+        ++lo;
+      }
+      if (s0 < 3.0) {
+        smooth[i] = height[i];
+        continue;
+      }
+      const double mean_u = su / s0;
+      const double mean_h = sh / s0;
+      const double var_u = suu / s0 - mean_u * mean_u;
+      const double cov = suh / s0 - mean_u * mean_h;
+      const double slope = var_u > 1e-6 ? cov / var_u : 0.0;
+      smooth[i] = mean_h + slope * ((ui - u0) - mean_u);
+    }
+  };
+  fit();
+  std::vector<double> residual(n);
+  for (int i = 0; i < n; ++i) residual[i] = std::abs(height[i] - smooth[i]);
+  std::vector<double> sorted = residual;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const double limit = std::max(0.005, 3.0 * 1.4826 * sorted[n / 2]);
+  for (int i = 0; i < n; ++i) use[i] = residual[i] <= limit;
+  fit();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d ray = points[i].p_body - left_centre_body;
+    const double denominator = road.normal_body.dot(ray);
+    if (!(std::abs(denominator) > 1e-9)) continue;
+    const double t =
+        (smooth[i] + road.offset_m - road.normal_body.dot(left_centre_body)) /
+        denominator;
+    if (t > 0.0) points[i].p_chain_body = left_centre_body + t * ray;
+  }
 }
 
 PlaneFrame PlaneFrame::Make(const RoadPlane& plane,
@@ -397,6 +478,49 @@ std::vector<AccumulatorComponent> ParallelLineComponents(
   return components;
 }
 
+LongSide FitLongSide(const std::vector<EdgePoint3d>& points,
+                     std::vector<int> support, const PlaneFrame& frame,
+                     const Eigen::Vector2d& direction_2d, int direction_set) {
+  LongSide side;
+  side.direction_set = direction_set;
+  side.direction_2d = direction_2d;
+  const Eigen::Vector2d normal(-direction_2d.y(), direction_2d.x());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : support) mean += points[i].p_chain_body;
+  mean /= static_cast<double>(support.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int i : support) {
+    const Eigen::Vector3d d = points[i].p_chain_body - mean;
+    scatter += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  Eigen::Vector3d axis = solver.eigenvectors().col(2);
+  if (axis.dot(frame.Direction3d(direction_2d)) < 0.0) axis = -axis;
+  side.point_body = mean;
+  side.direction_body = axis;
+  side.t_begin = 1e30;
+  side.t_end = -1e30;
+  const Eigen::Vector3d across = frame.normal.cross(axis).normalized();
+  double lateral_ss = 0.0, height_ss = 0.0, contrast = 0.0;
+  for (int i : support) {
+    const Eigen::Vector3d d = points[i].p_chain_body - mean;
+    const double t = d.dot(axis);
+    side.t_begin = std::min(side.t_begin, t);
+    side.t_end = std::max(side.t_end, t);
+    const Eigen::Vector3d r = d - t * axis;
+    lateral_ss += r.dot(across) * r.dot(across);
+    height_ss += r.dot(frame.normal) * r.dot(frame.normal);
+    contrast += points[i].gradient.dot(normal);
+  }
+  const double count = static_cast<double>(support.size());
+  side.lateral_rms_m = std::sqrt(lateral_ss / count);
+  side.height_rms_m = std::sqrt(height_ss / count);
+  side.contrast = contrast / count;
+  side.lateral_m = frame.To2d(mean).dot(normal);
+  side.support = std::move(support);
+  return side;
+}
+
 LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
                                   const PlaneFrame& frame,
                                   const ZebraSpecification& zebra,
@@ -407,7 +531,7 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
     const int first_index = static_cast<int>(result.points.size());
     for (const EdgePoint3d& p : chain.points) {
       result.points.push_back(p);
-      result.points_2d.push_back(frame.To2d(p.p_body));
+      result.points_2d.push_back(frame.To2d(p.p_chain_body));
     }
     const int n = static_cast<int>(chain.points.size());
     int start = 0;
@@ -484,6 +608,11 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
           continue;
         }
         groups.push_back(MakeGroup(result.points_2d, s.support, direction));
+        double contrast = 0.0;
+        for (int i : s.support) {
+          contrast += result.points[i].gradient.dot(normal);
+        }
+        groups.back().polarity = contrast >= 0.0 ? 1 : -1;
       }
       groups =
           MergeCollinear(result.points_2d, std::move(groups), direction,
@@ -502,43 +631,8 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
       for (Group& g : groups) {
         VLOG(3) << "  group length " << g.Length() << " rms " << g.rms_m;
         if (g.Length() < options.min_long_side_length_m) continue;
-        // 3D regression on the group's points.
-        LongSide side;
-        side.direction_set = set;
-        side.direction_2d = direction;
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (int i : g.support) mean += result.points[i].p_body;
-        mean /= static_cast<double>(g.support.size());
-        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-        for (int i : g.support) {
-          const Eigen::Vector3d d = result.points[i].p_body - mean;
-          scatter += d * d.transpose();
-        }
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
-        Eigen::Vector3d axis = solver.eigenvectors().col(2);
-        if (axis.dot(frame.Direction3d(direction)) < 0.0) axis = -axis;
-        side.point_body = mean;
-        side.direction_body = axis;
-        side.t_begin = 1e30;
-        side.t_end = -1e30;
-        const Eigen::Vector3d across = frame.normal.cross(axis).normalized();
-        double lateral_ss = 0.0, height_ss = 0.0, contrast = 0.0;
-        for (int i : g.support) {
-          const Eigen::Vector3d d = result.points[i].p_body - mean;
-          const double t = d.dot(axis);
-          side.t_begin = std::min(side.t_begin, t);
-          side.t_end = std::max(side.t_end, t);
-          const Eigen::Vector3d r = d - t * axis;
-          lateral_ss += r.dot(across) * r.dot(across);
-          height_ss += r.dot(frame.normal) * r.dot(frame.normal);
-          contrast += result.points[i].gradient.dot(normal);
-        }
-        const double count = static_cast<double>(g.support.size());
-        side.lateral_rms_m = std::sqrt(lateral_ss / count);
-        side.height_rms_m = std::sqrt(height_ss / count);
-        side.contrast = contrast / count;
-        side.lateral_m = frame.To2d(mean).dot(normal);
-        side.support = std::move(g.support);
+        LongSide side = FitLongSide(result.points, std::move(g.support),
+                                    frame, direction, set);
         VLOG(2) << "long side " << result.sides.size() << ": set " << set
                 << " lateral " << side.lateral_m << " extent " << side.t_begin
                 << " " << side.t_end << " contrast " << side.contrast

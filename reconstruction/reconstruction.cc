@@ -311,6 +311,7 @@ PairReconstruction StereoPairReconstructor::Reconstruct(
     const EdgePoint& e = edges[0].points[m.left];
     p.xy_left = Eigen::Vector2d(e.x, e.y);
     p.gradient = Eigen::Vector2d(e.gx, e.gy);
+    p.index_in_chain = e.index_in_chain;
     by_chain[e.chain].push_back({e.index_in_chain, p});
     points.push_back(p.p_body);
   }
@@ -341,7 +342,11 @@ PairReconstruction StereoPairReconstructor::Reconstruct(
         off_road_xy.push_back(p.xy_left);
       }
     }
-    if (kept.points.size() >= 2) chains.push_back(std::move(kept));
+    if (kept.points.size() < 2) continue;
+    RegulariseChainHeights(fit.plane, centre,
+                           options_.long_sides.height_smoothing_half_window,
+                           &kept);
+    chains.push_back(std::move(kept));
   }
   result.timings.road_plane_s = ThreadCpuSeconds() - start;
   if (stop_after_road_plane || !fit.ok) return result;

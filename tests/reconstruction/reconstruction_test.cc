@@ -24,12 +24,22 @@ namespace {
 struct Score {
   int visible = 0;
   int detected = 0;
+  // By range of the band's centre from the left camera: 0-8, 8-11, 11-15 m.
+  int visible_at[3] = {0, 0, 0};
+  int detected_at[3] = {0, 0, 0};
   int reported = 0;
   int false_bands = 0;
   int correct = 0;  // all 4 vertices within 3 cm
   double sum_squares_close = 0.0;
   int vertices_close = 0;  // within 10 m of the left camera
   double Detection() const { return detected / std::max(1.0, 1.0 * visible); }
+  double DetectionAt(int bin) const {
+    return detected_at[bin] / std::max(1.0, 1.0 * visible_at[bin]);
+  }
+  double DetectionWithin11m() const {
+    return (detected_at[0] + detected_at[1]) /
+           std::max(1.0, 1.0 * (visible_at[0] + visible_at[1]));
+  }
   double Correct() const {
     return correct / std::max(1.0, 1.0 * (reported - false_bands));
   }
@@ -157,9 +167,14 @@ class SmallSurvey : public ::testing::Test {
         }
         const Eigen::Vector3d left_centre =
             rig.cameras[rig.stereo_pairs[0][0]].T_body_cam.translation();
-        if (!visible || (centre - left_centre).norm() > 15.0) continue;
+        const double range = (centre - left_centre).norm();
+        if (!visible || range > 15.0) continue;
+        const int bin = range <= 8.0 ? 0 : (range <= 11.0 ? 1 : 2);
+        const int seen = found[e.exposure_id].count(static_cast<int>(b));
         ++score.visible;
-        score.detected += found[e.exposure_id].count(static_cast<int>(b));
+        score.detected += seen;
+        ++score.visible_at[bin];
+        score.detected_at[bin] += seen;
       }
     }
     return score;
@@ -259,6 +274,73 @@ TEST_F(SmallSurvey, ReconstructsTheVisibleBandsToTheCentimetre) {
     SCOPED_TRACE("unreadable image");
     UnreadableImageSkipsItsExposureWithAWarning(*folder_);
   }
+}
+
+// Recall at range (issue 17): a 1024x768 rig, lower and with a shorter
+// baseline than the presets', two skewed crossings of at least 6 bands, an
+// exposure every 2 m so each band is seen at every range. Far bands (11-15 m)
+// span a few original pixels along the road: their long sides must not break up
+// (stereo depth noise) and their ends must not tilt (the crossing's direction).
+class FarBands : public SmallSurvey {
+ protected:
+  static void SetUpTestSuite() {
+    far_folder_ = new std::string(
+        (std::filesystem::temp_directory_path() /
+         ("zebrageo-reconstruction-far-test-" + std::to_string(::getpid())))
+            .string());
+    SimulationOptions options;
+    ASSERT_EQ(ApplyPreset("demo", &options), "");
+    options.seed = 11;
+    options.road_length_m = 62.0;
+    options.num_crossings = 2;
+    options.num_stale_crossings = 0;
+    options.min_crossing_spacing_m = 20.0;
+    options.min_bands_per_crossing = 6;
+    options.exposure_spacing_m = 2.0;
+    options.image_width = 1024;
+    options.image_height = 768;
+    options.focal_px = 880.0;
+    options.camera_height_m = 2.2;
+    options.stereo_baseline_m = 0.9;
+    options.skew_probability = 1.0;  // the ends' direction matters
+    ASSERT_EQ(options.Check(), "");
+    SimulateSurvey(options, *far_folder_, nullptr);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ignored;
+    std::filesystem::remove_all(*far_folder_, ignored);
+    delete far_folder_;
+  }
+  static std::string* far_folder_;
+};
+
+std::string* FarBands::far_folder_ = nullptr;
+
+TEST_F(FarBands, FindsTheFarBandsOfA1024x768RigWithoutAFalseOne) {
+  SurveyLoadOptions load;
+  load.load_roadmarks = false;
+  const Survey survey = LoadSurvey(*far_folder_, load);
+  ReconstructionOptions options;
+  options.threads = 2;
+  std::vector<ReconstructedVertex> vertices;
+  const ReconstructionSummary summary =
+      ReconstructSurvey(survey, options, &vertices);
+  ASSERT_TRUE(summary.IsUsable()) << summary.message;
+  const Score score = ScoreAgainstTruth(survey, vertices);
+  LOG(INFO) << "detection 0-8 m " << score.detected_at[0] << "/"
+            << score.visible_at[0] << ", 8-11 m " << score.detected_at[1] << "/"
+            << score.visible_at[1] << ", 11-15 m " << score.detected_at[2]
+            << "/" << score.visible_at[2] << ", all-4-within-3cm "
+            << score.Correct() << ", RMSE (<= 10 m) " << score.RmseClose()
+            << " m, false bands " << score.false_bands;
+  // 31 and 32 band views (seed 11).
+  ASSERT_GE(score.visible_at[0] + score.visible_at[1], 25);
+  ASSERT_GE(score.visible_at[2], 25);
+  EXPECT_GE(score.DetectionWithin11m(), 0.97);
+  EXPECT_GE(score.DetectionAt(2), 0.9);
+  EXPECT_EQ(score.false_bands, 0);
+  EXPECT_GE(score.Correct(), 0.9);
+  EXPECT_LT(score.RmseClose(), 0.015);
 }
 
 TEST(ReconstructionOptions, CheckNamesTheBadNestedField) {

@@ -1,0 +1,59 @@
+#include "reconstruction/crossing_regularity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace zebrageo {
+
+bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
+                          int crossing, int min_count,
+                          Eigen::Vector2d* direction_2d) {
+  constexpr double kPi = 3.14159265358979323846;
+  // Ends this close to the median are averaged (a near end's angle is good
+  // to about 0.01 rad, a far one's to a few hundredths).
+  constexpr double kInlierAngleRad = 0.05;
+  const EndDirectionObservation* heaviest = nullptr;
+  int count = 0;
+  for (const EndDirectionObservation& o : all) {
+    if (o.crossing != crossing || !(o.weight > 0.0)) continue;
+    ++count;
+    if (heaviest == nullptr || o.weight > heaviest->weight) heaviest = &o;
+  }
+  if (count < min_count || heaviest == nullptr) return false;
+  const double reference =
+      std::atan2(heaviest->direction_2d.y(), heaviest->direction_2d.x());
+  // (angle from the reference in (-pi/2, pi/2], weight)
+  std::vector<std::pair<double, double>> angles;
+  double total = 0.0;
+  for (const EndDirectionObservation& o : all) {
+    if (o.crossing != crossing || !(o.weight > 0.0)) continue;
+    const double angle = std::atan2(o.direction_2d.y(), o.direction_2d.x());
+    angles.push_back({std::remainder(angle - reference, kPi), o.weight});
+    total += o.weight;
+  }
+  std::sort(angles.begin(), angles.end());
+  double cumulated = 0.0;
+  double median = angles.back().first;
+  for (const auto& [angle, weight] : angles) {
+    cumulated += weight;
+    if (cumulated >= 0.5 * total) {
+      median = angle;
+      break;
+    }
+  }
+  // The weighted mean of the angles near the median: as robust, and not
+  // tied to one observation's noise.
+  double sum = 0.0, sum_weights = 0.0;
+  for (const auto& [angle, weight] : angles) {
+    if (std::abs(angle - median) > kInlierAngleRad) continue;
+    sum += weight * angle;
+    sum_weights += weight;
+  }
+  const double mean = sum / sum_weights;
+  *direction_2d =
+      Eigen::Vector2d(std::cos(reference + mean), std::sin(reference + mean));
+  return true;
+}
+
+}  // namespace zebrageo

@@ -1,0 +1,35 @@
+// The regularity of a zebra crossing, used to make its far bands as
+// reliable as its near ones: the bands of one crossing are painted
+// parallel, with parallel ends (a skewed crossing's bands are
+// parallelograms of one shape).
+//
+// Frames: the 2D plane frame of long_sides.h (metres); directions are
+// unit vectors, taken modulo pi (a line has no orientation).
+#ifndef ZEBRAGEO_RECONSTRUCTION_CROSSING_REGULARITY_H_
+#define ZEBRAGEO_RECONSTRUCTION_CROSSING_REGULARITY_H_
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace zebrageo {
+
+// One estimate of the direction of a band's end, with its weight (inverse
+// variance, up to a common factor).
+struct EndDirectionObservation {
+  int crossing = 0;
+  Eigen::Vector2d direction_2d = Eigen::Vector2d::UnitY();
+  double weight = 1.0;
+};
+
+// The direction of the ends of crossing `crossing`: the weighted mean of
+// its observations' angles within 0.05 rad of their weighted median
+// (angles modulo pi, measured from its heaviest observation), so that a few
+// wrong ends, a stain's slanted edge, do not pull it. False with fewer than
+// `min_count` observations of that crossing.
+bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
+                          int crossing, int min_count,
+                          Eigen::Vector2d* direction_2d);
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_RECONSTRUCTION_CROSSING_REGULARITY_H_
