@@ -11,10 +11,11 @@
 #include <sstream>
 #include <utility>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Two hypotheses of one observation closer than this are one hypothesis.
 constexpr double kDuplicateHypothesisM = 0.1;
 // Observations of one crossing further apart in time start a new pass.
