@@ -59,6 +59,8 @@ int Main(int argc, char** argv) {
   AddAdjustCommand(&app, &commands);
   AddRunCommands(&app, &commands);
   AddImportOpenCvStereoCommand(&app, &commands);
+  AddImportCalibrationCommands(&app, &commands);
+  AddImportTrajectoryCommand(&app, &commands);
 
   try {
     app.parse(argc, argv);
