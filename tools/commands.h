@@ -59,7 +59,8 @@ void AddImportOpenCvStereoCommand(CLI::App* app,
 void AddImportCalibrationCommands(CLI::App* app,
                                   std::vector<Command>* commands);
 void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands);
-
+// export-gcp (tools/export_command.cc).
+void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands);
 
 }  // namespace zebrageo
 

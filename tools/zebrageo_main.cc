@@ -61,6 +61,7 @@ int Main(int argc, char** argv) {
   AddImportOpenCvStereoCommand(&app, &commands);
   AddImportCalibrationCommands(&app, &commands);
   AddImportTrajectoryCommand(&app, &commands);
+  AddExportGcpCommand(&app, &commands);
 
   try {
     app.parse(argc, argv);
