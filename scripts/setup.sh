@@ -11,6 +11,7 @@ PACKAGES=(
   libpng-dev libtiff-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev
+  libproj-dev proj-bin proj-data
   python3 python3-numpy python3-opencv python3-yaml
   chromium
 )
