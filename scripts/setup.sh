@@ -12,6 +12,7 @@ PACKAGES=(
   zlib1g-dev tzdata libgdal-dev gdal-bin
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev
+  libproj-dev proj-bin proj-data
   python3 python3-numpy python3-opencv python3-yaml
   chromium
 )
