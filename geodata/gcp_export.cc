@@ -2,15 +2,18 @@
 
 #include <glog/logging.h>
 
+#include <GeographicLib/UTMUPS.hpp>
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <tuple>
 
 #include "survey/atomic_file.h"
+#include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
 
@@ -196,13 +199,40 @@ GcpCoordinateSystem Wgs84GcpCoordinates() {
 
 GcpCoordinates GcpCoordinatesFor(const std::string& definition,
                                  const Geodetic& near) {
-  (void)near;
   if (definition.empty() || definition == "WGS84" ||
       definition == "EPSG:4326" || definition == "EPSG:4979") {
     return {Wgs84GcpCoordinates(), "EPSG:4979"};
   }
-  throw std::invalid_argument("--crs " + definition +
-                              ": only WGS84 until the PROJ wrapper lands");
+  std::string crs_definition = definition;
+  std::string header;
+  if (definition == "utm") {
+    // The zone is a rule of the UTM grid (GeographicLib); the projection
+    // itself is PROJ's, as every CRS.
+    const int zone =
+        GeographicLib::UTMUPS::StandardZone(near.lat_deg, near.lon_deg);
+    const bool north = near.lat_deg >= 0.0;
+    if (zone == GeographicLib::UTMUPS::UPS) {
+      throw CrsError("utm: the survey is in a polar UPS area; name a CRS");
+    }
+    crs_definition = "EPSG:" + std::to_string((north ? 32600 : 32700) + zone);
+    header = "WGS84 UTM " + std::to_string(zone) + (north ? "N" : "S");
+  }
+  const Crs crs(crs_definition);
+  if (header.empty()) {
+    const std::string& id = crs.identifier();
+    const bool single_code =
+        id.rfind("EPSG:", 0) == 0 && id.find('+') == std::string::npos;
+    if (single_code) {
+      header = id;
+    } else if (definition.find("+proj") != std::string::npos) {
+      header = definition;
+    }
+  }
+  auto transformer = std::make_shared<CrsTransformer>(crs);
+  return {
+      {header,
+       [transformer](const Geodetic& g) { return transformer->FromWgs84(g); }},
+      crs_definition};
 }
 
 Eigen::Vector2d OpenSfmNormalized(const Eigen::Vector2d& uv, int width,

@@ -104,8 +104,11 @@ struct GcpCoordinates {
   std::string srs_definition;  // "EPSG:4979" for WGS84
 };
 // For `definition`: "" (WGS84), "utm" (the WGS84 UTM zone of `near`, header
-// "WGS84 UTM 32N"), or any CRS PROJ knows (survey/crs.h). Throws
-// UsageError-free std::invalid_argument naming the CRS when PROJ refuses it.
+// "WGS84 UTM 32N", EPSG:326zz/327zz), or any CRS PROJ knows (survey/crs.h:
+// EPSG code, compound code with a geoid, PROJ string, WKT), transformed by
+// PROJ. The header is the CRS as gcp_list.txt names one: "EPSG:<code>" or
+// the PROJ string given; "" when ODM cannot name it (a compound CRS: ODM's
+// reader takes one EPSG code). Throws CrsError (unknown CRS, missing grid).
 GcpCoordinates GcpCoordinatesFor(const std::string& definition,
                                  const Geodetic& near);
 

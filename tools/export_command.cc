@@ -8,6 +8,7 @@
 #include <string>
 
 #include "geodata/gcp_export.h"
+#include "survey/crs.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
@@ -46,8 +47,18 @@ void RunExportGcp(const ExportArguments& args) {
     throw StageFailedError("no ground control point in " + args.results +
                            " (no matched crossing): nothing to export");
   }
-  const GcpCoordinates coordinates =
-      GcpCoordinatesFor(args.crs, survey.frame.origin());
+  GcpCoordinates coordinates;
+  try {
+    coordinates = GcpCoordinatesFor(args.crs, survey.frame.origin());
+  } catch (const CrsError& error) {
+    throw UsageError(std::string("--crs: ") + error.what());
+  }
+  if (args.format == "odm" && coordinates.system.header.empty()) {
+    throw UsageError("--crs " + args.crs +
+                     ": ODM's gcp_list.txt names its CRS by one EPSG code or "
+                     "a PROJ string; give the horizontal EPSG code (heights "
+                     "are then ellipsoidal)");
+  }
   if (args.format == "odm") {
     WriteOdmGcpList(gcps, coordinates.system, args.output);
   } else if (args.format == "opensfm") {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -47,6 +48,19 @@ class GcpExport : public ::testing::Test {
                           folder_->Path("run.out"), folder_->Path("run.err")),
               0)
         << ReadWholeFile(folder_->Path("run.err"));
+    // Two crossings are too few for the adjustment to hold one out as check
+    // points (--check-share): the first crossing is marked check here, as
+    // a larger survey's adjustment would, so that the exports' handling of
+    // roles is tested. Everything else is the run's own output.
+    const std::string residuals = Results("gcp_residuals.csv");
+    std::vector<GcpResidual> rows =
+        ReadGcpResiduals(residuals, "gcp_residuals.csv");
+    ASSERT_FALSE(rows.empty());
+    const std::string check_crossing = rows.front().crossing_id;
+    for (GcpResidual& r : rows) {
+      if (r.crossing_id == check_crossing) r.role = GcpRole::kCheck;
+    }
+    WriteGcpResiduals(rows, residuals);
   }
   static void TearDownTestSuite() {
     delete folder_;
@@ -182,6 +196,8 @@ TEST_F(GcpExport, OdmGcpListFollowsTheSpecificationAndTheTruth) {
   ASSERT_TRUE(std::getline(in, line));
   EXPECT_EQ(line, "EPSG:4326");
   int observations = 0;
+  double max_pixel_error = 0.0;
+  double max_database_error_m = 0.0;
   std::map<std::string, int> per_point;
   while (std::getline(in, line)) {
     const std::vector<std::string> w = Words(line);
@@ -196,15 +212,19 @@ TEST_F(GcpExport, OdmGcpListFollowsTheSpecificationAndTheTruth) {
         truth.NearestTrueCorner(position, &distance_m);
     EXPECT_LT(distance_m, kMaxDatabaseErrorM) << line;
     EXPECT_TRUE(fs::exists(Survey("images/" + w[5]))) << w[5];
-    EXPECT_LT(
-        truth.PixelError(corner, w[5],
-                         Eigen::Vector2d(std::stod(w[3]), std::stod(w[4]))),
-        kMaxPixelError)
-        << line;
+    const double pixel_error = truth.PixelError(
+        corner, w[5], Eigen::Vector2d(std::stod(w[3]), std::stod(w[4])));
+    EXPECT_LT(pixel_error, kMaxPixelError) << line;
+    max_pixel_error = std::max(max_pixel_error, pixel_error);
+    max_database_error_m = std::max(max_database_error_m, distance_m);
     ++observations;
     ++per_point[w[6]];
   }
-  EXPECT_GE(per_point.size(), 8u);  // two crossings, several bands each
+  std::cout << per_point.size() << " control points, " << observations
+            << " observations; largest distance to a true corner "
+            << max_database_error_m << " m, largest image error "
+            << max_pixel_error << " px\n";
+  EXPECT_GE(per_point.size(), 8u);  // several bands of a crossing
   EXPECT_GE(observations, 2 * static_cast<int>(per_point.size()));
   // Only control points: check points are left to the adjustment.
   for (const GcpResidual& r :
@@ -213,6 +233,64 @@ TEST_F(GcpExport, OdmGcpListFollowsTheSpecificationAndTheTruth) {
                              "/" + std::to_string(r.vertex);
     EXPECT_EQ(per_point.count(name) > 0, r.role == GcpRole::kControl) << name;
   }
+}
+
+// `--crs utm` writes ODM's "WGS84 UTM <zone><N|S>" header and coordinates
+// that agree with PROJ's own cs2cs applied to the WGS84 export, to 1 mm.
+TEST_F(GcpExport, OdmUtmCoordinatesAgreeWithCs2cs) {
+  if (std::system("command -v cs2cs >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "cs2cs (proj-bin) is not installed";
+  }
+  const std::string wgs84 = folder_->Path("gcp_wgs84.txt");
+  const std::string utm = folder_->Path("gcp_utm.txt");
+  ASSERT_EQ(Export("--format odm", wgs84), 0) << ExportError();
+  ASSERT_EQ(Export("--format odm --crs utm", utm), 0) << ExportError();
+  std::ifstream wgs84_in(wgs84);
+  std::ifstream utm_in(utm);
+  std::string wgs84_line, utm_line;
+  std::getline(wgs84_in, wgs84_line);
+  std::getline(utm_in, utm_line);
+  EXPECT_EQ(utm_line, "WGS84 UTM 31N");  // the simulator's survey, at 2.3 E
+  // cs2cs reads EPSG:4979 as latitude, longitude, height.
+  const std::string cs2cs_in = folder_->Path("cs2cs.in");
+  const std::string cs2cs_out = folder_->Path("cs2cs.out");
+  std::vector<std::vector<std::string>> utm_rows;
+  {
+    std::ofstream out(cs2cs_in);
+    while (std::getline(wgs84_in, wgs84_line) &&
+           std::getline(utm_in, utm_line)) {
+      const std::vector<std::string> w = Words(wgs84_line);
+      out << w[1] << " " << w[0] << " " << w[2] << "\n";
+      utm_rows.push_back(Words(utm_line));
+    }
+  }
+  ASSERT_FALSE(utm_rows.empty());
+  ASSERT_EQ(std::system(("cs2cs -f %.6f EPSG:4979 EPSG:32631 < " +
+                         Quote(cs2cs_in) + " > " + Quote(cs2cs_out))
+                            .c_str()),
+            0);
+  std::ifstream expected_in(cs2cs_out);
+  std::string expected_line;
+  double max_difference_m = 0.0;
+  for (const std::vector<std::string>& row : utm_rows) {
+    ASSERT_TRUE(std::getline(expected_in, expected_line));
+    const std::vector<std::string> e = Words(expected_line);
+    ASSERT_EQ(e.size(), 3u) << expected_line;
+    for (int axis = 0; axis < 3; ++axis) {
+      max_difference_m =
+          std::max(max_difference_m,
+                   std::abs(std::stod(row[axis]) - std::stod(e[axis])));
+    }
+  }
+  EXPECT_LT(max_difference_m, 0.001);
+}
+
+TEST_F(GcpExport, AnUnknownCrsIsAUsageError) {
+  const std::string path = folder_->Path("never.txt");
+  EXPECT_EQ(Export("--format odm --crs EPSG:999999", path), 2);
+  EXPECT_NE(ExportError().find("EPSG:999999"), std::string::npos)
+      << ExportError();
+  EXPECT_FALSE(fs::exists(path));
 }
 
 // OpenSfM's documentation (docs/gcp.html): {"points": [{"id": ..., "position":
