@@ -157,8 +157,8 @@ TEST(CalibrationImport, KalibrAndRosGiveTheOpenCvImportsRig) {
 
 // An equidistant lens of moderate field (Kalibr's model for any lens):
 // the fitted OpenCV model projects like cv::fisheye::projectPoints over the
-// whole image. (At 83 degrees across the diagonal, fx = 900 here, the best
-// fit departs by 1.6 px: refused, as the next test shows for a fisheye.)
+// whole image. (With fx = 900 px, 51 degrees to the corner, the best fit
+// departs by 1.6 px: refused, as the next test shows for a fisheye.)
 TEST(CalibrationImport, EquidistantKalibrCameraProjectsLikeOpenCvFisheye) {
   TemporaryFolder tmp;
   const double fx = 1500.0, fy = 1499.0, cx = 640.3, cy = 480.9;

@@ -292,7 +292,8 @@ TEST(NovatelImport, SimulatedTrajectoryReadsBackToTheSamePoses) {
   TemporaryFolder tmp;
   std::vector<TrajectorySample> truth = SimulatedTrajectory(tmp);
   // A 4-degree roll, so that SPAN's Z-X-Y angle order differs measurably
-  // from the contract's Z-Y-X (angle by angle they would be 1e-2 deg off).
+  // from the contract's Z-Y-X (by about roll x pitch: read angle by angle
+  // they would be a few 1e-2 deg off).
   const std::string path = tmp.Write("span.log", NovatelLog(truth, 4.0));
   for (TrajectorySample& s : truth) s.attitude.roll += DegToRad(4.0);
   const std::vector<TrajectorySample> read = ReadNovatelAscii(path);
