@@ -19,6 +19,12 @@ constexpr double kOrthonormalTolerance = 1e-6;
 // A baseline longer than this is almost surely in millimetres.
 constexpr double kMaxPlausibleBaselineM = 10.0;
 
+// The line of `node`, or 0 for a key that is absent (yaml-cpp throws when
+// asked the position of a node that does not exist).
+int LineOf(const YAML::Node& node) {
+  return node.IsDefined() ? YamlLine(node) : 0;
+}
+
 std::string ReadText(const std::string& path, const char* what) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, std::string("cannot read the ") + what);
@@ -27,23 +33,24 @@ std::string ReadText(const std::string& path, const char* what) {
   return text.str();
 }
 
-// Numbers of a flat or nested YAML list (Kalibr writes 4x4 as nested).
+// Numbers of a flat list, or of a list of lists (Kalibr writes 4x4 as
+// rows): `depth` more levels of nesting are accepted.
 std::vector<double> Numbers(const YAML::Node& node, const std::string& key,
-                            const std::string& path) {
+                            const std::string& path, int depth = 1) {
   std::vector<double> values;
   if (!node || !node.IsSequence()) {
-    throw InputError(path, YamlLine(node),
+    throw InputError(path, LineOf(node),
                      "'" + key + "' must be a list of numbers");
   }
   for (const YAML::Node& item : node) {
-    if (item.IsSequence()) {
-      for (double v : Numbers(item, key, path)) values.push_back(v);
+    if (item.IsSequence() && depth > 0) {
+      for (double v : Numbers(item, key, path, depth - 1)) values.push_back(v);
       continue;
     }
     double value = 0.0;
     if (!item.IsScalar() || !YAML::convert<double>::decode(item, value) ||
         !std::isfinite(value)) {
-      throw InputError(path, YamlLine(item),
+      throw InputError(path, LineOf(item),
                        "'" + key + "' holds something that is not a number");
     }
     values.push_back(value);
@@ -55,11 +62,11 @@ std::vector<double> Required(const YAML::Node& parent, const std::string& key,
                              size_t size, const std::string& path) {
   const YAML::Node node = parent[key];
   if (!node) {
-    throw InputError(path, YamlLine(parent), "missing key '" + key + "'");
+    throw InputError(path, LineOf(parent), "missing key '" + key + "'");
   }
   const std::vector<double> values = Numbers(node, key, path);
   if (values.size() != size) {
-    throw InputError(path, YamlLine(node),
+    throw InputError(path, LineOf(node),
                      "'" + key + "' must have " + std::to_string(size) +
                          " numbers, not " + std::to_string(values.size()));
   }
@@ -70,17 +77,18 @@ std::string RequiredString(const YAML::Node& parent, const std::string& key,
                            const std::string& path) {
   const YAML::Node node = parent[key];
   if (!node || !node.IsScalar()) {
-    throw InputError(path, YamlLine(parent), "missing text key '" + key + "'");
+    throw InputError(path, LineOf(parent), "missing text key '" + key + "'");
   }
   return node.Scalar();
 }
 
-int RequiredInt(const YAML::Node& node, const std::string& key,
+int RequiredInt(const YAML::Node& parent, const std::string& key,
                 const std::string& path) {
+  const YAML::Node node = parent[key];
   int value = 0;
   if (!node || !node.IsScalar() || !YAML::convert<int>::decode(node, value) ||
       value <= 0) {
-    throw InputError(path, YamlLine(node),
+    throw InputError(path, node ? LineOf(node) : LineOf(parent),
                      "'" + key + "' must be a positive integer");
   }
   return value;
@@ -96,7 +104,7 @@ Eigen::Matrix3d RotationOf(const std::vector<double>& row_major, int stride,
   const double error =
       (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (error > kOrthonormalTolerance || R.determinant() < 0.0) {
-    throw InputError(path, YamlLine(node),
+    throw InputError(path, LineOf(node),
                      "'" + key + "' rotation is not orthonormal");
   }
   return R;
@@ -108,7 +116,7 @@ void CheckBaseline(const Eigen::Vector3d& t, const YAML::Node& node,
     std::ostringstream problem;
     problem << "baseline " << t.norm()
             << " is implausible in metres (millimetres?)";
-    throw InputError(path, YamlLine(node), problem.str());
+    throw InputError(path, LineOf(node), problem.str());
   }
 }
 
@@ -122,7 +130,7 @@ std::array<double, 5> OpenCvDistortion(const std::string& model,
                                        const std::string& path) {
   auto need = [&](size_t n) {
     if (coefficients.size() != n) {
-      throw InputError(path, YamlLine(node),
+      throw InputError(path, LineOf(node),
                        "distortion model '" + model + "' needs " +
                            std::to_string(n) + " coefficients, not " +
                            std::to_string(coefficients.size()));
@@ -137,7 +145,7 @@ std::array<double, 5> OpenCvDistortion(const std::string& model,
     if (coefficients.size() < 4 || coefficients.size() > 8) need(5);
     for (size_t i = 5; i < coefficients.size(); ++i) {
       if (coefficients[i] != 0.0) {
-        throw InputError(path, YamlLine(node),
+        throw InputError(path, LineOf(node),
                          "rational distortion terms k4..k6 are not zero; "
                          "rig.yaml holds only [k1, k2, p1, p2, k3]");
       }
@@ -157,11 +165,11 @@ std::array<double, 5> OpenCvDistortion(const std::string& model,
                  "departs by "
               << fit.max_error_px << " px in the image (limit "
               << options.max_fit_error_px << " px)";
-      throw InputError(path, YamlLine(node), problem.str());
+      throw InputError(path, LineOf(node), problem.str());
     }
     return fit.distortion;
   }
-  throw InputError(path, YamlLine(node),
+  throw InputError(path, LineOf(node),
                    "unsupported distortion model '" + model +
                        "' (radtan, plumb_bob, equidistant)");
 }
@@ -188,12 +196,12 @@ RosCamera ReadRosCamera(const std::string& path, const std::string& name,
   const YAML::Node root =
       ParseYamlDocument(ReadText(path, "ROS camera_info file"), path);
   if (!root.IsMap()) throw InputError(path, 1, "expected a YAML mapping");
-  const int width = RequiredInt(root["image_width"], "image_width", path);
-  const int height = RequiredInt(root["image_height"], "image_height", path);
+  const int width = RequiredInt(root, "image_width", path);
+  const int height = RequiredInt(root, "image_height", path);
   auto data = [&](const std::string& key, size_t size) {
     const YAML::Node node = root[key];
     if (!node || !node.IsMap()) {
-      throw InputError(path, YamlLine(root),
+      throw InputError(path, LineOf(root),
                        "missing '" + key + "' with rows, cols and data");
     }
     return size == 0 ? Numbers(node["data"], key + ".data", path)
@@ -202,7 +210,7 @@ RosCamera ReadRosCamera(const std::string& path, const std::string& name,
   const std::vector<double> k = data("camera_matrix", 9);
   if (k[1] != 0.0 || k[3] != 0.0 || k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0 ||
       !(k[0] > 0.0) || !(k[4] > 0.0)) {
-    throw InputError(path, YamlLine(root["camera_matrix"]),
+    throw InputError(path, LineOf(root["camera_matrix"]),
                      "camera_matrix must be [fx 0 cx; 0 fy cy; 0 0 1] with "
                      "fx, fy > 0");
   }
@@ -220,7 +228,7 @@ RosCamera ReadRosCamera(const std::string& path, const std::string& name,
     for (int c = 0; c < 4; ++c) ros.P(r, c) = p[r * 4 + c];
   }
   if (!(ros.P(0, 0) > 0.0) || !(ros.P(1, 1) > 0.0)) {
-    throw InputError(path, YamlLine(root["projection_matrix"]),
+    throw InputError(path, LineOf(root["projection_matrix"]),
                      "projection_matrix must have fx', fy' > 0");
   }
   ros.projection_node = root["projection_matrix"];
@@ -297,20 +305,29 @@ Rig ImportKalibrCamchain(const std::string& path,
   for (int n = 0; n < count; ++n) {
     const std::string key = "cam" + std::to_string(n);
     const YAML::Node cam = root[key];
-    if (!cam.IsMap())
-      throw InputError(path, YamlLine(cam), key + ": not a map");
+    if (!cam.IsMap()) throw InputError(path, LineOf(cam), key + ": not a map");
     const std::string model = RequiredString(cam, "camera_model", path);
     if (model != "pinhole") {
-      throw InputError(path, YamlLine(cam["camera_model"]),
+      throw InputError(path, LineOf(cam["camera_model"]),
                        key + ": camera_model '" + model +
                            "' is not supported (pinhole only)");
     }
     const std::vector<double> intrinsics = Required(cam, "intrinsics", 4, path);
     const std::vector<double> resolution = Required(cam, "resolution", 2, path);
-    if (!(intrinsics[0] > 0.0) || !(intrinsics[1] > 0.0) ||
-        !(resolution[0] >= 1.0) || !(resolution[1] >= 1.0)) {
-      throw InputError(path, YamlLine(cam),
-                       key + ": focal lengths and resolution must be > 0");
+    // Whole pixels, and few enough that the int they become cannot overflow.
+    constexpr double kMaxImageSidePx = 100000.0;
+    for (double side : resolution) {
+      if (!(side >= 1.0 && side <= kMaxImageSidePx) ||
+          side != std::floor(side)) {
+        throw InputError(path, LineOf(cam["resolution"]),
+                         key +
+                             ": resolution must be two whole numbers of "
+                             "pixels in [1, 100000]");
+      }
+    }
+    if (!(intrinsics[0] > 0.0) || !(intrinsics[1] > 0.0)) {
+      throw InputError(path, LineOf(cam["intrinsics"]),
+                       key + ": focal lengths must be > 0");
     }
     const int width = static_cast<int>(resolution[0]);
     const int height = static_cast<int>(resolution[1]);
@@ -328,7 +345,7 @@ Rig ImportKalibrCamchain(const std::string& path,
       const Eigen::Vector3d translation(t[3], t[7], t[11]);
       CheckBaseline(translation, cam["T_cn_cnm1"], path);
       if (t[12] != 0.0 || t[13] != 0.0 || t[14] != 0.0 || t[15] != 1.0) {
-        throw InputError(path, YamlLine(cam["T_cn_cnm1"]),
+        throw InputError(path, LineOf(cam["T_cn_cnm1"]),
                          key + ": T_cn_cnm1's last row must be 0 0 0 1");
       }
       T_body_cam = T_body_previous * IsometryOf(R, translation).inverse();
@@ -357,7 +374,7 @@ Rig ImportRosCameraInfoPair(const std::string& left_path,
       right.P(1, 3) / right.P(1, 1) - left.P(1, 3) / left.P(1, 1), 0.0);
   CheckBaseline(b_rect, right.projection_node, right_path);
   if (b_rect.norm() == 0.0) {
-    throw InputError(right_path, YamlLine(right.projection_node),
+    throw InputError(right_path, LineOf(right.projection_node),
                      "projection_matrix has no baseline (Tx = 0): is this "
                      "the right camera's file?");
   }

@@ -227,6 +227,25 @@ TEST(CalibrationImport, BadFilesNameTheLine) {
     EXPECT_NE(e.problem().find("'intrinsics' must have 4"), std::string::npos)
         << e.what();
   }
+  // A Kalibr file given as ROS camera_info: missing keys are InputErrors
+  // (yaml-cpp throws its own exception when asked where an absent key is;
+  // found by fuzz_calibration).
+  EXPECT_THROW(
+      ImportRosCameraInfoPair(path, path, Eigen::Isometry3d::Identity(), {}),
+      InputError);
+  // A resolution no int holds is refused, not cast.
+  const std::string huge = tmp.Write(
+      "huge.yaml",
+      "cam0:\n  camera_model: pinhole\n  intrinsics: [300, 300, 640, 480]\n"
+      "  distortion_model: radtan\n  distortion_coeffs: [0, 0, 0, 0]\n"
+      "  resolution: [1e300, 960]\n");
+  try {
+    ImportKalibrCamchain(huge, Eigen::Isometry3d::Identity(), {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 6);
+    EXPECT_NE(e.problem().find("resolution"), std::string::npos) << e.what();
+  }
   const std::string ros =
       tmp.Write("left.yaml",
                 "image_width: 640\nimage_height: 480\n"
