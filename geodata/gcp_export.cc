@@ -198,7 +198,8 @@ GcpCoordinateSystem Wgs84GcpCoordinates() {
 }
 
 GcpCoordinates GcpCoordinatesFor(const std::string& definition,
-                                 const Geodetic& near) {
+                                 const Geodetic& near,
+                                 const std::vector<std::string>& grid_dirs) {
   if (definition.empty() || definition == "WGS84" ||
       definition == "EPSG:4326" || definition == "EPSG:4979") {
     return {Wgs84GcpCoordinates(), "EPSG:4979"};
@@ -228,7 +229,9 @@ GcpCoordinates GcpCoordinatesFor(const std::string& definition,
       header = definition;
     }
   }
-  auto transformer = std::make_shared<CrsTransformer>(crs);
+  CrsOptions options;
+  options.grid_dirs = grid_dirs;
+  auto transformer = std::make_shared<CrsTransformer>(crs, options);
   return {
       {header,
        [transformer](const Geodetic& g) { return transformer->FromWgs84(g); }},

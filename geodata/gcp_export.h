@@ -109,8 +109,9 @@ struct GcpCoordinates {
 // PROJ. The header is the CRS as gcp_list.txt names one: "EPSG:<code>" or
 // the PROJ string given; "" when ODM cannot name it (a compound CRS: ODM's
 // reader takes one EPSG code). Throws CrsError (unknown CRS, missing grid).
-GcpCoordinates GcpCoordinatesFor(const std::string& definition,
-                                 const Geodetic& near);
+GcpCoordinates GcpCoordinatesFor(
+    const std::string& definition, const Geodetic& near,
+    const std::vector<std::string>& grid_dirs = {});
 
 // Writers (atomic). `gcps` are written in order, observations in order.
 void WriteOdmGcpList(const std::vector<GroundControlPoint>& gcps,

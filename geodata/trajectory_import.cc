@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "geodata/gps_time.h"
+#include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
@@ -152,11 +153,12 @@ void CheckImportedSamples(const std::vector<TrajectorySample>& samples,
 std::string CsvTrajectoryFormat::Check() const {
   std::set<std::string> known(RequiredNames().begin(), RequiredNames().end());
   known.insert(AccuracyNames().begin(), AccuracyNames().end());
+  known.insert({"x", "y"});  // with a CRS
   for (const auto& [name, column] : columns) {
     if (!known.count(name)) {
       return "columns: unknown name '" + name +
              "' (time, lat, lon, h, roll, pitch, heading, sd_e, sd_n, sd_u, "
-             "sd_roll, sd_pitch, sd_heading)";
+             "sd_roll, sd_pitch, sd_heading; x, y with a CRS)";
     }
     if (column.empty()) return "columns: '" + name + "' maps to nothing";
   }
@@ -190,7 +192,17 @@ std::vector<TrajectorySample> ReadTrajectoryCsv(
   text << in.rdbuf();
   std::vector<std::string> required;
   for (const std::string& name : RequiredNames()) {
+    if (!format.crs.empty() && (name == "lat" || name == "lon")) continue;
     required.push_back(FileColumn(format, name));
+  }
+  std::unique_ptr<CrsTransformer> transformer;
+  if (!format.crs.empty()) {
+    required.push_back(FileColumn(format, "x"));
+    required.push_back(FileColumn(format, "y"));
+    CrsOptions crs_options;
+    crs_options.grid_dirs = format.grid_dirs;
+    transformer =
+        std::make_unique<CrsTransformer>(Crs(format.crs), crs_options);
   }
   const CsvTable table = CsvTable::Parse(
       AsCommaSeparated(text.str(), format.delimiter, path), path, required);
@@ -219,9 +231,18 @@ std::vector<TrajectorySample> ReadTrajectoryCsv(
     TrajectorySample s;
     times.push_back(ReadTime(table, row, FileColumn(format, "time"), format,
                              leap_seconds.get()));
-    s.position.lat_deg = RadToDeg(get("lat") * angle);
-    s.position.lon_deg = RadToDeg(get("lon") * angle);
-    s.position.h_m = get("h");
+    if (transformer) {
+      try {
+        s.position =
+            transformer->ToWgs84(Eigen::Vector3d(get("x"), get("y"), get("h")));
+      } catch (const CrsError& crs_error) {
+        table.Fail(row, crs_error.what());
+      }
+    } else {
+      s.position.lat_deg = RadToDeg(get("lat") * angle);
+      s.position.lon_deg = RadToDeg(get("lon") * angle);
+      s.position.h_m = get("h");
+    }
     s.attitude = NormalizedAttitude(
         {get("roll") * angle, get("pitch") * angle, get("heading") * angle});
     if (has_accuracy) {

@@ -81,6 +81,16 @@ struct CsvTrajectoryFormat {
   Delimiter delimiter = Delimiter::kComma;
   // IERS leap-second list, for TimeKind::kUtc.
   std::string leap_seconds_file = "/usr/share/zoneinfo/leap-seconds.list";
+  // CRS of the positions (survey/crs.h: EPSG code, compound code with a
+  // geoid, PROJ string, WKT), "" for WGS84 latitude, longitude and
+  // ellipsoidal height. Given one, the columns are x, y (its easting and
+  // northing, or longitude and latitude in degrees) and h (its height:
+  // orthometric for a compound CRS), transformed to WGS84 by PROJ; a
+  // missing geoid grid is an error naming it. The heading stays from true
+  // north: INS exports give true heading, never grid bearings.
+  std::string crs;
+  // Folders searched for its grids before PROJ's own (CrsOptions).
+  std::vector<std::string> grid_dirs;
 
   // "" or what is wrong ("columns: unknown name 'yaw'").
   std::string Check() const;

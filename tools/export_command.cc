@@ -22,6 +22,7 @@ struct ExportArguments {
   std::string format;
   std::string output;
   std::string crs;
+  std::vector<std::string> grid_dirs;
   bool include_check_points = false;
   bool image_paths = false;
   bool allow_outside_paths = false;
@@ -49,7 +50,8 @@ void RunExportGcp(const ExportArguments& args) {
   }
   GcpCoordinates coordinates;
   try {
-    coordinates = GcpCoordinatesFor(args.crs, survey.frame.origin());
+    coordinates =
+        GcpCoordinatesFor(args.crs, survey.frame.origin(), args.grid_dirs);
   } catch (const CrsError& error) {
     throw UsageError(std::string("--crs: ") + error.what());
   }
@@ -106,6 +108,9 @@ void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands) {
                   "survey's WGS84 UTM zone, ODM's usual), an EPSG code or a "
                   "PROJ string; default WGS84 longitude, latitude, "
                   "ellipsoidal height. opensfm is always WGS84.");
+  sub->add_option("--grid-dir", args->grid_dirs,
+                  "a folder holding PROJ grids (geoid models), searched "
+                  "first");
   sub->add_flag("--include-check", args->include_check_points,
                 "odm, opensfm: also write the adjustment's check points "
                 "(those tools would use them as control)");

@@ -12,6 +12,7 @@
 #include "geodata/calibration_import.h"
 #include "geodata/gps_time.h"
 #include "geodata/trajectory_import.h"
+#include "survey/crs.h"
 #include "survey/input_error.h"
 #include "survey/rig.h"
 #include "tools/commands.h"
@@ -41,6 +42,8 @@ struct TrajectoryArguments {
   std::string time = "week-seconds";
   std::string delimiter = "comma";
   std::string leap_seconds = kDefaultLeapSecondsFile;
+  std::string crs;
+  std::vector<std::string> grid_dirs;
 };
 
 // Mounting of the left camera on the vehicle: camera looking forward
@@ -88,6 +91,8 @@ CsvTrajectoryFormat CsvFormatOf(const TrajectoryArguments& args) {
                      : args.delimiter == "semicolon" ? Delimiter::kSemicolon
                                                      : Delimiter::kComma;
   format.leap_seconds_file = args.leap_seconds;
+  format.crs = args.crs;
+  format.grid_dirs = args.grid_dirs;
   if (!args.columns.empty()) {
     const std::string error = ParseColumnMap(args.columns, &format);
     if (!error.empty()) throw UsageError("--columns: " + error);
@@ -95,17 +100,27 @@ CsvTrajectoryFormat CsvFormatOf(const TrajectoryArguments& args) {
   return format;
 }
 
+std::vector<TrajectorySample> ReadTrajectory(const TrajectoryArguments& args) {
+  if (args.format == "sbet") return ReadSbet(args.input, args.smrmsg);
+  if (!args.smrmsg.empty()) {
+    throw UsageError("--smrmsg goes with --format sbet only");
+  }
+  return args.format == "novatel"
+             ? ReadNovatelAscii(args.input)
+             : ReadTrajectoryCsv(args.input, CsvFormatOf(args));
+}
+
 void RunImportTrajectory(const TrajectoryArguments& args) {
+  if (!args.crs.empty() && args.format != "csv") {
+    throw UsageError(
+        "--crs goes with --format csv only (SBET and NovAtel "
+        "logs are WGS84)");
+  }
   std::vector<TrajectorySample> samples;
-  if (args.format == "sbet") {
-    samples = ReadSbet(args.input, args.smrmsg);
-  } else {
-    if (!args.smrmsg.empty()) {
-      throw UsageError("--smrmsg goes with --format sbet only");
-    }
-    samples = args.format == "novatel"
-                  ? ReadNovatelAscii(args.input)
-                  : ReadTrajectoryCsv(args.input, CsvFormatOf(args));
+  try {
+    samples = ReadTrajectory(args);
+  } catch (const CrsError& error) {
+    throw UsageError(std::string("--crs: ") + error.what());
   }
   WriteTrajectorySamples(samples, args.output);
   LOG(INFO) << "wrote " << args.output << " (" << samples.size()
@@ -213,6 +228,13 @@ void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--leap-seconds", args->leap_seconds,
                   "csv --time utc: IERS leap-seconds.list")
       ->capture_default_str();
+  sub->add_option("--crs", args->crs,
+                  "csv: CRS of the positions (EPSG code, compound code with a "
+                  "geoid, PROJ string): columns x, y, h instead of lat, lon, "
+                  "h, transformed to WGS84 by PROJ");
+  sub->add_option("--grid-dir", args->grid_dirs,
+                  "csv --crs: a folder holding PROJ grids (geoid models), "
+                  "searched first");
   commands->push_back({sub, [args] { RunImportTrajectory(*args); }});
 }
 

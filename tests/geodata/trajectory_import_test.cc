@@ -379,6 +379,55 @@ TEST(CsvTrajectoryImport, InertialExplorerStyleExportInUtcAndRadians) {
   EXPECT_NEAR(read[3].sd_attitude_rad.z(), truth[3].sd_attitude_rad.z(), 1e-15);
 }
 
+// An export in UTM 31N with EGM96 heights (the geoid grid proj-data ships):
+// its coordinates made by PROJ's own cs2cs from the simulated trajectory,
+// read back through the CRS wrapper to the same poses.
+TEST(CsvTrajectoryImport, ProjectedCrsWithGeoidHeightsReadsBack) {
+  if (std::system("command -v cs2cs >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "cs2cs (proj-bin) is not installed";
+  }
+  TemporaryFolder tmp;
+  const std::vector<TrajectorySample> truth = SimulatedTrajectory(tmp);
+  {
+    std::ofstream out(tmp.Path("wgs84.txt"));
+    out << std::setprecision(17);
+    for (const TrajectorySample& s : truth) {
+      out << s.position.lat_deg << " " << s.position.lon_deg << " "
+          << s.position.h_m << "\n";
+    }
+  }
+  ASSERT_EQ(
+      std::system(("cs2cs -f %.6f EPSG:4979 EPSG:32631+5773 < '" +
+                   tmp.Path("wgs84.txt") + "' > '" + tmp.Path("utm.txt") + "'")
+                      .c_str()),
+      0);
+  std::ifstream utm(tmp.Path("utm.txt"));
+  std::ostringstream text;
+  text << "GPSTime,Easting,Northing,H-MSL,Roll,Pitch,Heading\n"
+       << std::setprecision(17);
+  double first_height = 0.0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    double x = 0.0, y = 0.0, h = 0.0;
+    ASSERT_TRUE(utm >> x >> y >> h);
+    if (i == 0) first_height = h;
+    const TrajectorySample& s = truth[i];
+    text << s.time << "," << x << "," << y << "," << h << ","
+         << RadToDeg(s.attitude.roll) << "," << RadToDeg(s.attitude.pitch)
+         << "," << RadToDeg(s.attitude.heading) << "\n";
+  }
+  // The geoid is applied (EGM96 is 40-50 m above the ellipsoid in France):
+  // a silently ellipsoidal height would not be 40 m off.
+  EXPECT_GT(truth.front().position.h_m - first_height, 40.0);
+  const std::string path = tmp.Write("utm_export.csv", text.str());
+  CsvTrajectoryFormat format;
+  ASSERT_EQ(ParseColumnMap("time=GPSTime,x=Easting,y=Northing,h=H-MSL,"
+                           "roll=Roll,pitch=Pitch,heading=Heading",
+                           &format),
+            "");
+  format.crs = "EPSG:32631+5773";
+  ExpectSamePoses(truth, ReadTrajectoryCsv(path, format));
+}
+
 TEST(CsvTrajectoryImport, BadRowNamesTheLineAndColumn) {
   TemporaryFolder tmp;
   const std::string path = tmp.Write("t.csv",
