@@ -78,11 +78,15 @@ struct Demo {
 };
 
 // Makes the cache once, under a lock so that parallel ctest processes wait
-// for the first; removes the caches of older builds.
+// for the first; removes the caches of older builds. It lives in the build
+// tree (build/test-cache), not in /tmp: another build's tests (a second
+// checkout on the same machine) would remove it while this one reads it.
 const Demo& CachedDemo() {
   static Demo* demo = nullptr;
   if (demo != nullptr) return *demo;
-  const fs::path temp = fs::temp_directory_path();
+  const fs::path temp =
+      fs::path(ZEBRAGEO_BINARY).parent_path().parent_path() / "test-cache";
+  fs::create_directories(temp);
   const std::string prefix = "zebrageo-issue18-";
   const fs::path folder = temp / (prefix + BinaryStamp());
   demo = new Demo{(folder / "demo5").string(), (folder / "reference").string(),
