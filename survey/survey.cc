@@ -48,6 +48,53 @@ std::string FileKey(const YAML::Node& root, const char* key,
   return name;
 }
 
+// An optional CRS key: PROJ must know it (the grids are checked when the
+// survey is loaded, with the grid folders).
+SurveyCrs CrsKey(const YAML::Node& root, const char* key) {
+  SurveyCrs crs;
+  const YAML::Node node = root[key];
+  if (!node || node.IsNull()) return crs;
+  if (!node.IsScalar() || node.Scalar().empty()) {
+    Fail(node, std::string("'") + key +
+                   "' must be a CRS: an EPSG code (\"EPSG:2154\", "
+                   "\"EPSG:2154+5720\"), a PROJ string or WKT");
+  }
+  crs.definition = node.Scalar();
+  crs.line = LineOf(node);
+  try {
+    Crs parsed(crs.definition);
+  } catch (const CrsError& error) {
+    Fail(node, std::string("'") + key + "': " + error.what());
+  }
+  return crs;
+}
+
+std::vector<std::string> GridDirsKey(const YAML::Node& root,
+                                     const SurveyPaths& paths) {
+  std::vector<std::string> folders;
+  const YAML::Node node = root["crs_grid_dirs"];
+  if (!node || node.IsNull()) return folders;
+  if (!node.IsSequence()) {
+    Fail(node, "'crs_grid_dirs' must be a list of folders");
+  }
+  for (const YAML::Node& item : node) {
+    if (!item.IsScalar() || item.Scalar().empty()) {
+      Fail(item, "'crs_grid_dirs' must be a list of folder names");
+    }
+    const SurveyFile folder = paths.Resolve(item.Scalar());
+    if (folder.escapes()) {
+      Fail(item, "'crs_grid_dirs' names " + item.Scalar() + ", which " +
+                     folder.Problem());
+    }
+    if (!fs::is_directory(folder.path)) {
+      Fail(item, "'crs_grid_dirs' names " + item.Scalar() +
+                     ", which is not a folder");
+    }
+    folders.push_back(item.Scalar());
+  }
+  return folders;
+}
+
 Geodetic ParseOrigin(const YAML::Node& node) {
   if (!node.IsSequence() || node.size() != 3) {
     Fail(node, "'origin' must be [lat, lon, h] (degrees, degrees, metres)");
@@ -150,6 +197,10 @@ SurveyManifest ReadManifest(const std::string& survey_folder,
     manifest.origin = ParseOrigin(origin);
     manifest.origin_line = LineOf(origin);
   }
+  manifest.roadmarks_crs = CrsKey(root, "roadmarks_crs");
+  manifest.trajectory_crs = CrsKey(root, "trajectory_crs");
+  manifest.output_crs = CrsKey(root, "output_crs");
+  manifest.crs_grid_dirs = GridDirsKey(root, paths);
   return manifest;
 }
 
@@ -171,6 +222,21 @@ void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
         << FormatDouble(o.lon_deg) << ", " << FormatDouble(o.h_m)
         << "]  # lat, lon, h of the ENU origin\n";
   }
+  const std::pair<const char*, const SurveyCrs*> crs_keys[] = {
+      {"roadmarks_crs", &manifest.roadmarks_crs},
+      {"trajectory_crs", &manifest.trajectory_crs},
+      {"output_crs", &manifest.output_crs}};
+  for (const auto& [key, crs] : crs_keys) {
+    if (crs->is_set()) {
+      out << key << ": " << YamlString(crs->definition) << "\n";
+    }
+  }
+  if (!manifest.crs_grid_dirs.empty()) {
+    out << "crs_grid_dirs:\n";
+    for (const std::string& folder : manifest.crs_grid_dirs) {
+      out << "  - " << YamlString(folder) << "\n";
+    }
+  }
   file.Commit();
 }
 
@@ -191,6 +257,49 @@ std::string Survey::PathOf(const std::string& relative) const {
   return (fs::path(folder) / relative).string();
 }
 
+CrsOptions SurveyCrsOptions(const std::string& survey_folder,
+                            const SurveyManifest& manifest) {
+  CrsOptions options;
+  for (const std::string& folder_name : manifest.crs_grid_dirs) {
+    options.grid_dirs.push_back(
+        fs::absolute(fs::path(survey_folder) / folder_name).string());
+  }
+  return options;
+}
+
+CrsTransformer MakeSurveyCrsTransformer(const std::string& survey_folder,
+                                        const SurveyManifest& manifest,
+                                        const SurveyCrs& crs,
+                                        const std::string& key) {
+  try {
+    return CrsTransformer(Crs(crs.definition),
+                          SurveyCrsOptions(survey_folder, manifest));
+  } catch (const CrsError& error) {
+    throw InputError(kManifestFile, crs.line, key + ": " + error.what());
+  }
+}
+
+std::vector<TrajectorySample> ReadSurveyTrajectory(
+    const std::string& survey_folder, const SurveyManifest& manifest) {
+  const std::string path =
+      (fs::path(survey_folder) / manifest.trajectory).string();
+  if (!manifest.trajectory_crs.is_set()) {
+    return ReadTrajectorySamples(path, manifest.trajectory);
+  }
+  return ReadTrajectorySamplesInCrs(
+      path, manifest.trajectory,
+      MakeSurveyCrsTransformer(survey_folder, manifest, manifest.trajectory_crs,
+                               "trajectory_crs"));
+}
+
+RoadmarkDatabase ReadSurveyRoadmarks(
+    const std::string& survey_folder, const SurveyManifest& manifest,
+    const std::vector<TrajectorySample>& trajectory) {
+  (void)trajectory;
+  return ReadRoadmarks((fs::path(survey_folder) / manifest.roadmarks).string(),
+                       manifest.roadmarks);
+}
+
 Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
   const std::string problem = options.Check();
   if (!problem.empty()) {
@@ -208,8 +317,15 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
                      "no stereo_pairs: zebrageo needs at least one stereo "
                      "pair to reconstruct road marks");
   }
-  std::vector<TrajectorySample> samples = ReadTrajectorySamples(
-      survey.PathOf(manifest.trajectory), manifest.trajectory);
+  // Every CRS is checked here, output_crs included: a missing grid stops
+  // the survey before hours of processing, not at the last file written.
+  for (const auto& [key, crs] :
+       {std::pair{"roadmarks_crs", &manifest.roadmarks_crs},
+        std::pair{"output_crs", &manifest.output_crs}}) {
+    if (crs->is_set()) MakeSurveyCrsTransformer(folder, manifest, *crs, key);
+  }
+  std::vector<TrajectorySample> samples =
+      ReadSurveyTrajectory(folder, manifest);
   const Geodetic origin = manifest.origin.value_or(samples.front().position);
   survey.frame = LocalFrame(origin);
   survey.trajectory = Trajectory(std::move(samples), survey.frame);
@@ -290,7 +406,7 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
 
   if (options.load_roadmarks) {
     survey.roadmarks =
-        ReadRoadmarks(survey.PathOf(manifest.roadmarks), manifest.roadmarks);
+        ReadSurveyRoadmarks(folder, manifest, survey.trajectory.samples());
   }
 
   PlausibilityInput plausibility;

@@ -1,0 +1,124 @@
+// Helpers for the real-world geodata tests (issue 20): a small simulated
+// survey reconstructed once, variants of it processed by the real binary,
+// and PROJ's and GDAL's own command-line tools as independent references.
+#ifndef ZEBRAGEO_TESTS_TOOLS_GEODATA_UTIL_H_
+#define ZEBRAGEO_TESTS_TOOLS_GEODATA_UTIL_H_
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "survey/csv.h"
+#include "survey/results.h"
+#include "tests/survey/test_util.h"
+#include "tests/tools/cli_util.h"
+
+namespace zebrageo {
+
+namespace fs = std::filesystem;
+
+// True when `program` is on the PATH.
+inline bool HaveProgram(const std::string& program) {
+  return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) ==
+         0;
+}
+
+// Runs a shell command; its output (stdout and stderr) goes to `log`.
+inline int Shell(const std::string& command, const std::string& log) {
+  const int status =
+      std::system((command + " >" + Quote(log) + " 2>&1").c_str());
+  return status == -1 ? -1 : WEXITSTATUS(status);
+}
+
+// PROJ's cs2cs on many points: `in` rows of three numbers in the source
+// CRS's axis order, the same rows out in the target's (EPSG:4979 reads lat
+// lon h).
+inline std::vector<Eigen::Vector3d> Cs2cs(
+    const std::string& source, const std::string& target,
+    const std::vector<Eigen::Vector3d>& points, const std::string& folder) {
+  const std::string in = folder + "/cs2cs_in.txt";
+  const std::string out = folder + "/cs2cs_out.txt";
+  {
+    std::ofstream stream(in);
+    stream.precision(17);
+    for (const Eigen::Vector3d& p : points) {
+      stream << p.x() << " " << p.y() << " " << p.z() << "\n";
+    }
+  }
+  const int status =
+      std::system(("cs2cs -d 9 " + Quote(source) + " " + Quote(target) + " <" +
+                   Quote(in) + " >" + Quote(out))
+                      .c_str());
+  std::vector<Eigen::Vector3d> result;
+  if (status != 0) return result;
+  std::ifstream stream(out);
+  double x, y, z;
+  while (stream >> x >> y >> z) result.emplace_back(x, y, z);
+  return result;
+}
+
+// A CSV output with the named columns, as doubles, one vector per row.
+inline std::vector<std::vector<double>> CsvColumns(
+    const std::string& path, const std::vector<std::string>& columns) {
+  const CsvTable table = CsvTable::Read(path, path, columns);
+  std::vector<std::vector<double>> rows;
+  for (int row = 0; row < table.NumRows(); ++row) {
+    std::vector<double> values;
+    for (const std::string& column : columns) {
+      values.push_back(table.GetDouble(row, column));
+    }
+    rows.push_back(values);
+  }
+  return rows;
+}
+
+// The text of a CSV output without the output_crs comments and columns: what
+// a run without output_crs writes.
+inline std::string WithoutCrsColumns(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, result;
+  while (std::getline(in, line)) {
+    if (line.rfind("# output_crs", 0) == 0 ||
+        line.rfind("# crs_x,crs_y,crs_z:", 0) == 0) {
+      continue;
+    }
+    if (line.rfind("#", 0) != 0) {
+      // The three crs columns are the last ones of every row.
+      for (int i = 0; i < 3; ++i) line = line.substr(0, line.rfind(','));
+    }
+    result += line + "\n";
+  }
+  return result;
+}
+
+// The text without its `#` comment lines (a stage's timings).
+inline std::string WithoutComments(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, result;
+  while (std::getline(in, line)) {
+    if (line.rfind("#", 0) != 0) result += line + "\n";
+  }
+  return result;
+}
+
+// Appends lines to a survey's survey.yaml.
+inline void AppendToManifest(const std::string& survey,
+                             const std::string& lines) {
+  std::ofstream(survey + "/survey.yaml", std::ios::app) << lines;
+}
+
+// Copies a survey folder.
+inline void CopySurvey(const std::string& from, const std::string& to) {
+  fs::copy(from, to, fs::copy_options::recursive);
+}
+
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_TESTS_TOOLS_GEODATA_UTIL_H_
