@@ -12,6 +12,7 @@
 #include "survey/geodesy.h"
 #include "survey/plausibility.h"
 #include "survey/rig.h"
+#include "survey/roadmark_layer.h"
 #include "survey/roadmarks.h"
 #include "survey/survey_paths.h"
 #include "survey/trajectory.h"
@@ -43,6 +44,15 @@ struct SurveyManifest {
   // Folders (relative to the survey folder) searched for geoid and datum
   // grids before PROJ's own; `crs_grid_dirs` in survey.yaml.
   std::vector<std::string> crs_grid_dirs;
+  // A road-mark layer read through GDAL/OGR (survey/roadmark_layer.h):
+  // `roadmarks` may then be any vector file or a "PG:..." connection.
+  std::string roadmarks_layer;        // the layer or table; "": the only one
+  RoadmarkFields roadmarks_fields;    // attribute names; "": guessed
+  double roadmarks_margin_m = 200.0;  // read only around the trajectory
+
+  // Whether the database is read through GDAL (anything but a plain
+  // GeoJSON of the contract).
+  bool RoadmarksThroughGdal() const;
 };
 
 // Reads survey.yaml (a leading UTF-8 byte-order mark is allowed). Throws

@@ -7,12 +7,15 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "survey/csv.h"
@@ -117,6 +120,95 @@ inline void AppendToManifest(const std::string& survey,
 // Copies a survey folder.
 inline void CopySurvey(const std::string& from, const std::string& to) {
   fs::copy(from, to, fs::copy_options::recursive);
+}
+
+// A survey reconstructed once (reconstruct --lines), whose copies are
+// matched and adjusted with changes to their survey.yaml or files.
+class ReconstructedSurvey {
+ public:
+  // Simulates with `simulate_arguments`, or copies `source_survey` when
+  // `simulate_arguments` is empty. Check ok() after.
+  ReconstructedSurvey(const std::string& simulate_arguments,
+                      const std::string& source_survey = "") {
+    survey_ = folder_.Path("survey");
+    reconstructed_ = folder_.Path("reconstructed");
+    const std::string log = folder_.Path("setup.log");
+    if (simulate_arguments.empty()) {
+      CopySurvey(source_survey, survey_);
+    } else if (RunZebrageo(
+                   "simulate " + simulate_arguments + " -o " + Quote(survey_),
+                   log, log) != 0) {
+      error_ = ReadWholeFile(log);
+      return;
+    }
+    if (RunZebrageo("--log-level error reconstruct --lines " + Quote(survey_) +
+                        " -o " + Quote(reconstructed_),
+                    log, log) != 0) {
+      error_ = ReadWholeFile(log);
+    }
+  }
+
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  const std::string& survey() const { return survey_; }
+  const TemporaryFolder& folder() const { return folder_; }
+
+  // Copies the survey as `name`, appends `manifest_lines` to its
+  // survey.yaml, lets `prepare` change the copy, then runs match and
+  // adjust (with `adjust_arguments`) on the shared reconstruction. Returns
+  // the results folder, "" after an ADD_FAILURE when a command failed.
+  std::string ProcessCopy(
+      const std::string& name, const std::string& manifest_lines,
+      const std::function<void(const std::string&)>& prepare = nullptr,
+      const std::string& adjust_arguments = "") const {
+    const std::string survey = folder_.Path(name + "-survey");
+    const std::string results = folder_.Path(name + "-results");
+    CopySurvey(survey_, survey);
+    AppendToManifest(survey, manifest_lines);
+    fs::copy(reconstructed_, results, fs::copy_options::recursive);
+    if (prepare) prepare(survey);
+    const std::string log = folder_.Path(name + ".log");
+    for (const std::string& stage :
+         {std::string("match"), "adjust " + adjust_arguments}) {
+      if (RunZebrageo("--log-level error " + stage + " " + Quote(survey) +
+                          " -o " + Quote(results),
+                      log, log) != 0) {
+        ADD_FAILURE() << name << ": " << stage << ": " << ReadWholeFile(log);
+        return "";
+      }
+    }
+    return results;
+  }
+
+ private:
+  TemporaryFolder folder_;
+  std::string survey_;
+  std::string reconstructed_;
+  std::string error_;
+};
+
+// The largest distance between the camera positions (east, north, up) of
+// two poses.csv, and the largest difference of a quaternion component;
+// infinity when their rows differ in number.
+inline std::pair<double, double> PoseDifference(const std::string& a_path,
+                                                const std::string& b_path) {
+  const std::vector<std::string> columns = {"east", "north", "up", "qw",
+                                            "qx",   "qy",    "qz"};
+  const auto a = CsvColumns(a_path, columns);
+  const auto b = CsvColumns(b_path, columns);
+  if (a.size() != b.size() || a.empty()) {
+    return {INFINITY, INFINITY};
+  }
+  double worst_m = 0.0, worst_q = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Eigen::Vector3d d(a[i][0] - b[i][0], a[i][1] - b[i][1],
+                            a[i][2] - b[i][2]);
+    worst_m = std::max(worst_m, d.norm());
+    for (int k = 3; k < 7; ++k) {
+      worst_q = std::max(worst_q, std::abs(a[i][k] - b[i][k]));
+    }
+  }
+  return {worst_m, worst_q};
 }
 
 }  // namespace zebrageo
