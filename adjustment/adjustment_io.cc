@@ -415,27 +415,50 @@ void WriteAdjustmentResults(const AdjustmentData& data,
   WriteCameraPoses(result.camera_poses, out(kPosesFile));
 }
 
-int RemoveRejectedMatches(const AdjustmentData& data,
-                          const AdjustmentResult& result,
-                          const std::string& results_folder) {
+namespace {
+
+std::set<std::tuple<std::string, int, int>> RejectedVertices(
+    const AdjustmentResult& result) {
   std::set<std::tuple<std::string, int, int>> rejected;
-  std::set<std::string> rejected_crossings;
   for (const ControlPointResult& p : result.control_points) {
     if (p.status != ControlStatus::kRejected) continue;
     rejected.insert({p.crossing_id, p.band, p.db_vertex});
-    rejected_crossings.insert(p.crossing_id);
   }
-  if (rejected.empty()) return 0;
+  return rejected;
+}
+
+}  // namespace
+
+std::vector<VertexMatch> MatchesKeptAsControl(
+    const std::vector<VertexMatch>& matches, const AdjustmentResult& result) {
+  const auto rejected = RejectedVertices(result);
   std::vector<VertexMatch> kept;
+  for (const VertexMatch& m : matches) {
+    if (!rejected.count({m.crossing_id, m.band, m.db_vertex})) {
+      kept.push_back(m);
+    }
+  }
+  return kept;
+}
+
+int RemoveRejectedMatches(const AdjustmentData& data,
+                          const AdjustmentResult& result,
+                          const std::string& results_folder) {
+  const auto rejected = RejectedVertices(result);
+  if (rejected.empty()) return 0;
+  std::set<std::string> rejected_crossings;
+  for (const auto& vertex : rejected) {
+    rejected_crossings.insert(std::get<0>(vertex));
+  }
+  const std::vector<VertexMatch> kept =
+      MatchesKeptAsControl(data.matches, result);
   std::map<int64_t, int> kept_per_exposure;
+  for (const VertexMatch& m : kept) ++kept_per_exposure[m.exposure_id];
   std::set<int64_t> touched;
   for (const VertexMatch& m : data.matches) {
     if (rejected.count({m.crossing_id, m.band, m.db_vertex})) {
       touched.insert(m.exposure_id);
-      continue;
     }
-    kept.push_back(m);
-    ++kept_per_exposure[m.exposure_id];
   }
   const int removed = static_cast<int>(data.matches.size() - kept.size());
   if (removed == 0) return 0;

@@ -69,6 +69,11 @@ void WriteAdjustmentResults(const AdjustmentData& data,
                             const TiePointSummary* tie_summary,
                             const std::string& results_folder);
 
+// The vertex matches of `matches` that the adjustment did not reject: what
+// matches.csv keeps (below), and what a user's control is made of.
+std::vector<VertexMatch> MatchesKeptAsControl(
+    const std::vector<VertexMatch>& matches, const AdjustmentResult& result);
+
 // matches.csv holds the vertices that became control points
 // (SURVEY_FORMAT.md): the ones the adjustment rejected (a crossing
 // inconsistent with the others, matched one band off; a blunder) are

@@ -23,6 +23,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <algorithm>
 #include <iostream>
 #include <string>
 
@@ -70,9 +71,14 @@ int Main(int argc, char** argv) {
                  "dump this seed's survey and results to -o DIR");
   app.add_option("-o,--output", output, "folder of --verbose");
   app.add_flag("--quiet", quiet, "the summary only");
+  int log_level = -1;
+  app.add_option("--log", log_level,
+                 "the stages' logs to stderr, with VLOG up to this level "
+                 "(one seed at a time)");
   CLI11_PARSE(app, argc, argv);
   FLAGS_logtostderr = true;
-  FLAGS_minloglevel = google::GLOG_ERROR;
+  FLAGS_minloglevel = log_level < 0 ? google::GLOG_ERROR : google::GLOG_INFO;
+  FLAGS_v = std::max(0, log_level);
   google::InitGoogleLogging(argv[0]);
 
   const std::string problem = options.Check();

@@ -657,6 +657,41 @@ PoseCorrection Matcher::Refine(const Obs& obs, const Eval& eval,
   return c;
 }
 
+namespace {
+
+// How far one database band's long axis may lie from its true direction:
+// three standard deviations of the direction through the two end
+// midpoints (each the mean of two corners of sd sigma_xy per axis), plus
+// the reconstruction's own ~2 cm.
+double BandAxisTolerance(const IndexedBand& db) {
+  constexpr double kReconstructionSigmaM = 0.02;
+  const double sigma = std::hypot(db.sigma_xy_m, kReconstructionSigmaM) /
+                       std::max(db.length_m, 1.0);
+  return 3.0 * sigma;
+}
+
+// The correction one band pair suggests, its rotation held within the
+// heading gate: a rotation beyond it comes from the database band's
+// corner errors, not from the trajectory, and the translation is then
+// taken at the band's centre, where the rotation matters least.
+PoseCorrection SeedCorrection(const ObsBand& band, const IndexedBand& db,
+                              const Rigid2& fit, double max_angle,
+                              const Eigen::Vector2d& vehicle) {
+  PoseCorrection c{fit.angle, fit.t};
+  if (std::abs(fit.angle) <= max_angle) return c;
+  Eigen::Vector2d centre_q = Eigen::Vector2d::Zero();
+  Eigen::Vector2d centre_db = Eigen::Vector2d::Zero();
+  for (int k = 0; k < 4; ++k) {
+    centre_q += 0.25 * band.q[k];
+    centre_db += 0.25 * (db.corners_enu[k].head<2>() - vehicle);
+  }
+  c.heading_rad = std::clamp(fit.angle, -max_angle, max_angle);
+  c.shift_enu_m = centre_db - Rotation2(c.heading_rad) * centre_q;
+  return c;
+}
+
+}  // namespace
+
 void Matcher::GenerateHypotheses(int o) {
   const Obs& obs = obs_[o];
   std::vector<Hypothesis>& list = hypotheses_[o];
@@ -680,10 +715,15 @@ void Matcher::GenerateHypotheses(int o) {
               options_.max_width_difference_m) {
         continue;
       }
+      // One band's direction is only as good as its corners: a database
+      // band's long axis is off by about sigma_xy / length (5 cm on 3 m is
+      // 1 degree), which the heading gate must not turn into a rejection
+      // of the true correspondence.
+      const double band_max_angle = max_angle + BandAxisTolerance(db);
       // Axes are directions up to sign: |sin| of the angle between them.
       const double sin_angle = std::abs(band.shape.axis.x() * db.axis_enu.y() -
                                         band.shape.axis.y() * db.axis_enu.x());
-      if (sin_angle > std::sin(max_angle)) continue;
+      if (sin_angle > std::sin(band_max_angle)) continue;
       // The corner order with the smallest rotation that fits.
       Rigid2 best_fit;
       double best_rms = std::numeric_limits<double>::infinity();
@@ -696,7 +736,7 @@ void Matcher::GenerateHypotheses(int o) {
               db.corners_enu[PermutedCorner(perm, k)].head<2>() - obs.vehicle;
         }
         const Rigid2 fit = FitRigid2(a, b);
-        if (std::abs(fit.angle) > max_angle) continue;
+        if (std::abs(fit.angle) > band_max_angle) continue;
         double sum = 0.0;
         for (int k = 0; k < 4; ++k) {
           sum += (Rotation2(fit.angle) * a[k] + fit.t - b[k]).squaredNorm();
@@ -707,8 +747,13 @@ void Matcher::GenerateHypotheses(int o) {
           best_fit = fit;
         }
       }
+      VLOG(4) << "exposure " << obs.source->exposure_id << " band " << i
+              << " on database band " << db.band << ": rms " << best_rms
+              << " shift " << best_fit.t.transpose() << " angle "
+              << best_fit.angle;
       if (best_rms > options_.hit_tolerance_m) continue;
-      PoseCorrection c{best_fit.angle, best_fit.t};
+      PoseCorrection c =
+          SeedCorrection(band, db, best_fit, max_angle, obs.vehicle);
       if (c.shift_enu_m.norm() > gate) continue;
       bool explored = false;
       for (const Hypothesis& h : list) {
@@ -730,6 +775,8 @@ void Matcher::GenerateHypotheses(int o) {
         c = refined;
         eval = Evaluate(obs, c);
       }
+      VLOG(4) << "  -> " << c.shift_enu_m.transpose() << " " << c.heading_rad
+              << ": " << eval.hits.size() << " hits, own " << eval.score;
       if (eval.hits.empty()) continue;
       Hypothesis hypothesis;
       hypothesis.correction = c;
@@ -830,6 +877,25 @@ double Matcher::WindowEvidence(int o, const PoseCorrection& c,
     }
     if (agrees) {
       for (int b : g->eval.missing) ++missing_views[b];
+    }
+    if (VLOG_IS_ON(3) && units != nullptr) {
+      std::ostringstream line;
+      line << "  view " << input_.observations[q].exposure_id
+           << (agrees ? " agrees" : " near") << ": hits";
+      for (const Hit& hit : g->eval.hits) {
+        line << " " << hit.rec << "->" << index_.bands()[hit.db].band << "@"
+             << unit_of(hit.rec);
+      }
+      line << "; unexplained";
+      for (int rec : g->eval.unexplained) {
+        line << " " << rec << "@" << unit_of(rec) << (whole(rec) ? "" : "(cut)")
+             << (beyond_first.count(rec) ? "(beyond 1)" : "");
+      }
+      line << "; contradictions";
+      for (int rec : g->eval.contradictions) line << " " << rec;
+      line << "; missing";
+      for (int b : g->eval.missing) line << " " << index_.bands()[b].band;
+      VLOG(3) << line.str();
     }
   }
   // A database band missed in some views but seen in another was hidden
@@ -998,6 +1064,10 @@ void Matcher::DecideAlone(int o) {
   double one_end_strong = std::numeric_limits<double>::infinity();
   int one_end_runner = -1;
   for (size_t k = 0; k < list.size(); ++k) {
+    VLOG(3) << "hypothesis " << k << " of exposure "
+            << input_.observations[o].exposure_id << ": own "
+            << list[k].eval.score << ", aggregated " << list[k].aggregated
+            << ", shift " << list[k].correction.shift_enu_m.transpose();
     if (static_cast<int>(k) == best) continue;
     if (CorrectionDistance(list[k].correction, h.correction, obs.centroid_q) <
         distinct) {
@@ -1320,11 +1390,17 @@ void Matcher::ResolveFromNeighbours() {
       double gap = std::numeric_limits<double>::infinity();
       double bound = std::numeric_limits<double>::infinity();
       bool interpolated = false;
+      // Distance travelled bounds a multipath switch (a metre within tens
+      // of metres), time a smooth drift.
+      auto metres_to = [&](int q) {
+        return (obs_[q].vehicle - obs_[o].vehicle).norm();
+      };
       for (int q : {before, after}) {
         if (q < 0) continue;
         const double dt = std::abs(t - input_.observations[q].time_s);
-        const double b =
-            options_.resolve_base_m + options_.drift_rate_m_per_s * dt;
+        const double b = options_.resolve_base_m +
+                         std::max(options_.drift_rate_m_per_s * dt,
+                                  options_.max_drift_per_metre * metres_to(q));
         if (b < bound) {
           bound = b;
           gap = dt;
@@ -1343,11 +1419,20 @@ void Matcher::ResolveFromNeighbours() {
         const bool smooth = (cb.shift_enu_m - ca.shift_enu_m).norm() <=
                             options_.neighbour_tolerance_m +
                                 options_.max_drift_rate_m_per_s * (ta - tb);
-        const double b = options_.resolve_base_m +
-                         0.5 * options_.max_drift_acceleration_m_per_s2 *
-                             (t - tb) * (ta - t);
+        const double u = ta > tb ? (t - tb) / (ta - tb) : 0.5;
+        // Smooth drift bends little between two matches; a switch may lie
+        // anywhere between them, so the nearer match's distance counts too,
+        // with the part of their difference the interpolation puts on it.
+        const double switch_bound =
+            options_.max_drift_per_metre *
+                std::min(metres_to(before), metres_to(after)) +
+            (cb.shift_enu_m - ca.shift_enu_m).norm() * std::min(u, 1.0 - u);
+        const double b =
+            options_.resolve_base_m +
+            std::max(0.5 * options_.max_drift_acceleration_m_per_s2 * (t - tb) *
+                         (ta - t),
+                     switch_bound);
         if (smooth && b < bound) {
-          const double u = ta > tb ? (t - tb) / (ta - tb) : 0.5;
           predicted.heading_rad =
               (1.0 - u) * cb.heading_rad + u * ca.heading_rad;
           predicted.shift_enu_m =
@@ -1855,6 +1940,7 @@ std::string MatchOptions::Check() const {
       !non_negative("max_drift_rate_m_per_s", max_drift_rate_m_per_s) ||
       !positive("max_informative_tolerance_m", max_informative_tolerance_m) ||
       !non_negative("resolve_base_m", resolve_base_m) ||
+      !non_negative("max_drift_per_metre", max_drift_per_metre) ||
       !non_negative("max_drift_acceleration_m_per_s2",
                     max_drift_acceleration_m_per_s2) ||
       !non_negative("max_resolve_bound_m", max_resolve_bound_m) ||

@@ -176,9 +176,13 @@ struct MatchOptions {
   // time to the match, or, interpolating between matches at tb and ta,
   // max_drift_acceleration_m_per_s2 * (t - tb) * (ta - t) / 2 (an INS
   // drift is smooth: 1 m of error varying over a minute accelerates by
-  // ~0.01 m/s^2).
+  // ~0.01 m/s^2), whichever of these and max_drift_per_metre is larger.
   double resolve_base_m = 0.1;
   double max_drift_acceleration_m_per_s2 = 0.01;
+  // A GNSS/INS error may also switch by a metre within ~40 m of road
+  // (multipath in a street canyon) without the claimed sd showing it: the
+  // bound grows by this per metre travelled from the nearest match.
+  double max_drift_per_metre = 0.025;
   double max_resolve_bound_m = 0.4;
   double max_sd_ratio = 2.0;
 

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "registration/band_matcher.h"
 #include "registration/match_stage.h"
@@ -219,8 +220,12 @@ std::string GeometryRunResult::Line() const {
     return out.str();
   }
   out << bands_reconstructed << " band views; match " << wrong << " wrong/"
-      << right << " right, crossings " << crossings_matched << "/"
-      << crossings_matchable << "; ";
+      << right << " right";
+  if (rejected_by_adjustment > 0) {
+    out << " (" << rejected_by_adjustment << " rejected by the adjustment)";
+  }
+  out << ", crossings " << crossings_matched << "/" << crossings_matchable
+      << "; ";
   if (usable) {
     out << "H " << Fixed(100 * h_before_m, 1) << "->"
         << Fixed(100 * h_after_m, 1) << " V " << Fixed(100 * v_before_m, 1)
@@ -304,8 +309,6 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
       return probe.Classify(exposure_id, pose, band, seen);
     };
     const MatchResult match = MatchBands(input, MatchOptions());
-    const std::map<int64_t, Pose> true_pose = TruePoses(simulated);
-    ScoreMatches(simulated, reconstruction, true_pose, match.matches, &result);
     std::map<std::string, int> reasons;
     for (const CrossingDecision& d : match.decisions) {
       if (d.decision != Decision::kMatched) ++reasons[d.reason];
@@ -329,6 +332,14 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     adjust_input.matches = &match.matches;
     const AdjustmentResult adjusted =
         AdjustTrajectory(adjustment, adjust_input);
+    // Scored as the user gets them: matches.csv keeps only the vertices
+    // that became control (RemoveRejectedMatches).
+    const std::vector<VertexMatch> kept =
+        MatchesKeptAsControl(match.matches, adjusted);
+    result.rejected_by_adjustment =
+        static_cast<int>(match.matches.size() - kept.size());
+    ScoreMatches(simulated, reconstruction, TruePoses(simulated), kept,
+                 &result);
     result.usable = adjusted.summary.IsUsable();
     if (!result.usable) result.message = adjusted.summary.message;
     ScorePoses(simulated, survey, adjusted, &result);

@@ -61,8 +61,10 @@ struct GeometryRunResult {
   // Reconstruction.
   int bands_reconstructed = 0;
   // Matching.
+  // Of the matches kept as control (the adjustment's rejects removed).
   int wrong = 0;
   int right = 0;
+  int rejected_by_adjustment = 0;  // vertex matches
   // Wrong matches of vertices of bands the synthesis cut short (one end's
   // vertices 0.25-1 m inside the paint): the band is the right one, its
   // vertices are not where the database's are.
