@@ -249,6 +249,15 @@ SurveyManifest ReadManifest(const std::string& survey_folder,
   manifest.rig = FileKey(root, "rig", paths);
   manifest.trajectory = FileKey(root, "trajectory", paths);
   manifest.exposures = FileKey(root, "exposures", paths);
+  // A database is outside the survey folder: like a file there, only for
+  // a trusted survey (a survey from someone else must not make zebrageo
+  // connect to a server of its choosing).
+  if (IsDatabaseConnection(root["roadmarks"]) &&
+      !path_options.allow_outside_paths) {
+    Fail(root["roadmarks"],
+         "'roadmarks' names a PostGIS database, outside the survey folder: "
+         "pass --allow-outside-paths for a survey you trust");
+  }
   manifest.roadmarks = IsDatabaseConnection(root["roadmarks"])
                            ? root["roadmarks"].Scalar()
                            : FileKey(root, "roadmarks", paths);

@@ -155,12 +155,14 @@ class ReconstructedSurvey {
 
   // Copies the survey as `name`, appends `manifest_lines` to its
   // survey.yaml, lets `prepare` change the copy, then runs match and
-  // adjust (with `adjust_arguments`) on the shared reconstruction. Returns
+  // adjust (with `adjust_arguments`; `stage_arguments` go to both) on the
+  // shared reconstruction. Returns
   // the results folder, "" after an ADD_FAILURE when a command failed.
   std::string ProcessCopy(
       const std::string& name, const std::string& manifest_lines,
       const std::function<void(const std::string&)>& prepare = nullptr,
-      const std::string& adjust_arguments = "") const {
+      const std::string& adjust_arguments = "",
+      const std::string& stage_arguments = "") const {
     const std::string survey = folder_.Path(name + "-survey");
     const std::string results = folder_.Path(name + "-results");
     CopySurvey(survey_, survey);
@@ -170,8 +172,8 @@ class ReconstructedSurvey {
     const std::string log = folder_.Path(name + ".log");
     for (const std::string& stage :
          {std::string("match"), "adjust " + adjust_arguments}) {
-      if (RunZebrageo("--log-level error " + stage + " " + Quote(survey) +
-                          " -o " + Quote(results),
+      if (RunZebrageo("--log-level error " + stage + " " + stage_arguments +
+                          " " + Quote(survey) + " -o " + Quote(results),
                       log, log) != 0) {
         ADD_FAILURE() << name << ": " << stage << ": " << ReadWholeFile(log);
         return "";

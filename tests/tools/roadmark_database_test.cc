@@ -306,8 +306,16 @@ TEST_P(RoadmarkLayer, PostgisTableGivesSameMatchesAndPoses) {
       "postgis", "roadmarks_layer: zebra\n",
       [&server](const std::string& survey) {
         SetManifestKey(survey, "roadmarks", "\"" + server.Connection() + "\"");
-      });
+      },
+      "", "--allow-outside-paths");
   ExpectSameMatchesAndPoses(results, Reference(*survey_, true));
+  // A survey from someone else may not make zebrageo connect to a server.
+  const std::string out = survey_->folder().Path("pg-refused.out");
+  EXPECT_EQ(
+      RunZebrageo("check " + Quote(survey_->folder().Path("postgis-survey")),
+                  out, out),
+      1);
+  EXPECT_THAT(ReadWholeFile(out), HasSubstr("--allow-outside-paths"));
 }
 
 INSTANTIATE_TEST_SUITE_P(Surveys, RoadmarkLayer,
