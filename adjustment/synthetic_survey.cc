@@ -9,12 +9,12 @@
 #include <random>
 #include <set>
 
+#include "survey/math_util.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 
 // The road: heading and height as smooth functions of arc length s.

@@ -13,11 +13,11 @@
 #include <sstream>
 
 #include "survey/image_io.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr float kOrbScaleFactor = 1.2f;
 
 struct ImageFeatures {

@@ -31,12 +31,12 @@
 
 #include "registration/band_matcher.h"
 #include "registration/roadmark_index.h"
+#include "survey/math_util.h"
 #include "survey/roadmarks.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kTargetBands = 100000;
 
 struct Seed {

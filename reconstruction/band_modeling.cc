@@ -11,11 +11,10 @@
 
 #include "reconstruction/crossing_regularity.h"
 #include "reconstruction/road_plane.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 using Area = std::array<Eigen::Vector2d, 4>;
 

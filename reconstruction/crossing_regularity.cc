@@ -4,12 +4,13 @@
 #include <cmath>
 #include <utility>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 
 bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
                           int crossing, int min_count,
                           Eigen::Vector2d* direction_2d) {
-  constexpr double kPi = 3.14159265358979323846;
   // Ends this close to the median are averaged (a near end's angle is good
   // to about 0.01 rad, a far one's to a few hundredths).
   constexpr double kInlierAngleRad = 0.05;

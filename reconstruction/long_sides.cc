@@ -8,10 +8,11 @@
 #include <numeric>
 #include <sstream>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kDirectionBins = 180;
 
 // Total least squares line through 2D points: centre and unit direction.
@@ -631,8 +632,8 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
       for (Group& g : groups) {
         VLOG(3) << "  group length " << g.Length() << " rms " << g.rms_m;
         if (g.Length() < options.min_long_side_length_m) continue;
-        LongSide side = FitLongSide(result.points, std::move(g.support),
-                                    frame, direction, set);
+        LongSide side = FitLongSide(result.points, std::move(g.support), frame,
+                                    direction, set);
         VLOG(2) << "long side " << result.sides.size() << ": set " << set
                 << " lateral " << side.lateral_m << " extent " << side.t_begin
                 << " " << side.t_end << " contrast " << side.contrast

@@ -11,10 +11,11 @@
 #include <sstream>
 #include <utility>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Two hypotheses of one observation closer than this are one hypothesis.
 constexpr double kDuplicateHypothesisM = 0.1;
 // Observations of one crossing further apart in time start a new pass.
@@ -1057,10 +1058,9 @@ void Matcher::DecideAlone(int o) {
   int runner = -1;
   double margin = std::numeric_limits<double>::infinity();
   double both_ends = std::numeric_limits<double>::infinity();
-  // An alternative beaten at one end only, and there only by band counts
-  // (bands explained, a band beyond the crossing's last one): a database
-  // missing that end band, or an end band hidden in the images, would give
-  // the same counts. Its strong margin, and which it is.
+  // The band offset of the same crossing beaten by the least strong
+  // evidence (bare road where it puts paint, a band where it has a gap or
+  // nothing before band 1), and which it is.
   double one_end_strong = std::numeric_limits<double>::infinity();
   int one_end_runner = -1;
   for (size_t k = 0; k < list.size(); ++k) {
@@ -1080,7 +1080,11 @@ void Matcher::DecideAlone(int o) {
     }
     margin = std::min(margin, m.raw);
     both_ends = std::min(both_ends, m.both_ends);
-    if (m.both_ends < options_.min_margin && m.strong < one_end_strong) {
+    // Between band offsets of one crossing, band counts decide nothing:
+    // at either end a database missing its end band (not implied by the
+    // numbering when it is the last), or an end band hidden in the images
+    // (a parked vehicle, the image border, range), gives the same counts.
+    if (list[k].main_crossing == h.main_crossing && m.strong < one_end_strong) {
       one_end_strong = m.strong;
       one_end_runner = static_cast<int>(k);
     }
@@ -1130,9 +1134,9 @@ void Matcher::DecideAlone(int o) {
     ambiguous_[o] = true;
     ev.reason = "ambiguous: decided against " +
                 DescribeAlternative(obs, h, list[one_end_runner]) +
-                " by the band count at one end of the crossing alone "
-                "(evidence a database missing that end band, or an end band "
-                "hidden in the images, cannot fake: " +
+                " by band counts alone (evidence a database missing an "
+                "end band, or an end band hidden in the images, cannot "
+                "fake: " +
                 Fixed(std::max(0.0, one_end_strong), 2) + " < " +
                 Fixed(options_.min_strong_margin, 1) + ")";
     return;

@@ -148,13 +148,14 @@ struct MatchOptions {
   // is then matched only through continuity). false: one end decides and
   // the continuity check between crossings is the safety net.
   bool require_both_ends = false;
-  // Without require_both_ends, a hypothesis decided at one end must be
-  // decided there by at least this much strong evidence (in views: bare
-  // road where the alternative predicts a database band, held or implied
-  // by the numbering; a band in a gap of the crossing or beyond its band 1)
-  // and not by band counts alone, which a database missing an end band or
-  // an end band hidden in the images fakes. Refused (ambiguous) otherwise:
-  // continuity with neighbouring crossings may still resolve it.
+  // A hypothesis must beat every other band offset of its crossing by at
+  // least this much strong evidence (in views: bare road where the
+  // alternative predicts a database band, held or implied by the
+  // numbering; a band in a gap of the crossing or beyond its band 1), not
+  // by band counts alone, which a database missing an end band or an end
+  // band hidden in the images fakes, at one end or at both. Refused
+  // (ambiguous) otherwise: continuity with neighbouring crossings may
+  // still resolve it.
   double min_strong_margin = 1.0;
 
   // --- Continuity between crossings -------------------------------------

@@ -19,7 +19,7 @@ cmake --build "$build" -j "$(nproc)" --target fuzzers
 
 corpus="$build/corpus"
 rm -rf "$corpus"
-mkdir -p "$corpus"/{trajectory,rig,exposures,roadmarks,stage_outputs}
+mkdir -p "$corpus"/{trajectory,rig,exposures,roadmarks,stage_outputs,ins,calibration}
 survey="$build/seed-survey"
 if [ -x "$here/build/tools/zebrageo" ] && \
    "$here/build/tools/zebrageo" --log-level error simulate --preset demo \
@@ -34,9 +34,12 @@ cp "$here"/tests/fuzz/seeds/rig/* "$corpus/rig/"
 cp "$here"/tests/fuzz/seeds/exposures/* "$corpus/exposures/"
 cp "$here"/tests/fuzz/seeds/roadmarks/* "$corpus/roadmarks/"
 cp "$here"/tests/fuzz/seeds/stage_outputs/* "$corpus/stage_outputs/"
+cp "$here"/tests/fuzz/seeds/ins/* "$corpus/ins/"
+cp "$here"/tests/fuzz/seeds/calibration/* "$corpus/calibration/"
 
 failed=0
-for target in trajectory rig exposures roadmarks stage_outputs; do
+for target in trajectory rig exposures roadmarks stage_outputs ins \
+    calibration; do
   echo "fuzz: fuzz_$target for $seconds s" >&2
   if ! (cd "$build" && "./tests/fuzz/fuzz_$target" -max_total_time="$seconds" \
           -max_len=65536 -rss_limit_mb=2048 -print_final_stats=0 \

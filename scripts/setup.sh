@@ -9,6 +9,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libgeographiclib-dev
   libyaml-cpp-dev nlohmann-json3-dev libsimdjson-dev libcli11-dev libbz2-dev
   libpng-dev libtiff-dev
+  zlib1g-dev tzdata libgdal-dev gdal-bin
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev
   libproj-dev proj-bin proj-data

@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "simulator/noise.h"
+#include "survey/math_util.h"
 
 namespace zebrageo::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 // Half the distance between the wheels, for the roll on the camber.
 constexpr double kHalfTrackM = 0.8;

@@ -11,11 +11,10 @@
 #include "simulator/options_json.h"
 #include "simulator/simulator.h"
 #include "survey/csv.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // ------------------------------------------------------------ field table
 using FieldPointer =

@@ -6,11 +6,10 @@
 #include <cmath>
 
 #include "simulator/noise.h"
+#include "survey/math_util.h"
 
 namespace zebrageo::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Rounds a length to whole node spacings (at least one), so segment ends fall
 // on nodes and the curvature is linear between consecutive nodes.

@@ -26,6 +26,7 @@
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/exposures.h"
+#include "survey/math_util.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
 #include "survey/survey.h"
@@ -34,7 +35,6 @@
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadToDeg = 180.0 / kPi;
 
 std::string Fmt(double v) { return FormatDouble(v); }

@@ -10,11 +10,11 @@
 #include <random>
 
 #include "simulator/noise.h"
+#include "survey/math_util.h"
 
 namespace zebrageo::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 // The centreline starts kLeadIn before the driven part and ends kLookAhead
 // after it, so the cameras see road at the end of the drive.

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Eigen::Matrix3d FromRowMajor(const std::vector<double>& m) {
   Eigen::Matrix3d R;

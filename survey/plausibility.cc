@@ -13,11 +13,11 @@
 
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadToDeg = 180.0 / kPi;
 // Gaps listed one by one in the warnings before "and N more".
 constexpr int kMaxListedGaps = 3;

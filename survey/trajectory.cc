@@ -9,11 +9,11 @@
 #include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 
 const std::vector<std::string>& TrajectoryColumns() {

@@ -55,6 +55,12 @@ std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,
                                           const std::string& issue);
 void AddImportOpenCvStereoCommand(CLI::App* app,
                                   std::vector<Command>* commands);
+// import-kalibr, import-ros-camera-info.
+void AddImportCalibrationCommands(CLI::App* app,
+                                  std::vector<Command>* commands);
+void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands);
+// export-gcp (tools/export_command.cc).
+void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands);
 
 }  // namespace zebrageo
 

@@ -1,5 +1,7 @@
-// `zebrageo import-opencv-stereo CALIB -o rig.yaml`: converts an OpenCV
-// stereoCalibrate result (K1, D1, K2, D2, R, T) to the survey's rig.yaml.
+// The import commands: calibrations to rig.yaml (import-opencv-stereo,
+// import-kalibr, import-ros-camera-info) and INS trajectories to
+// trajectory.csv (import-trajectory). The conversions live in survey/rig.h
+// and geodata/; this file only maps arguments onto them.
 #include <glog/logging.h>
 
 #include <cmath>
@@ -7,19 +9,41 @@
 #include <string>
 #include <vector>
 
+#include "geodata/calibration_import.h"
+#include "geodata/gps_time.h"
+#include "geodata/trajectory_import.h"
+#include "survey/crs.h"
+#include "survey/input_error.h"
 #include "survey/rig.h"
 #include "tools/commands.h"
+#include "tools/exit_codes.h"
 
 namespace zebrageo {
 namespace {
 
 struct ImportArguments {
   std::string calibration;
+  std::string right_calibration;  // import-ros-camera-info
   std::string output;
   int width = 0;
   int height = 0;
   std::vector<double> lever_arm_m = {0.0, 0.0, 0.0};
   double pitch_down_deg = 0.0;
+  CalibrationImportOptions options;
+};
+
+struct TrajectoryArguments {
+  std::string input;
+  std::string format;
+  std::string smrmsg;
+  std::string output;
+  std::string columns;
+  std::string angles = "deg";
+  std::string time = "week-seconds";
+  std::string delimiter = "comma";
+  std::string leap_seconds = kDefaultLeapSecondsFile;
+  std::string crs;
+  std::vector<std::string> grid_dirs;
 };
 
 // Mounting of the left camera on the vehicle: camera looking forward
@@ -41,7 +65,178 @@ Eigen::Isometry3d ForwardLookingMount(const std::vector<double>& lever_arm_m,
   return T;
 }
 
+// The mount options every calibration import shares.
+void AddMountOptions(CLI::App* sub, ImportArguments* args) {
+  sub->add_option("-o,--output", args->output, "rig.yaml to write")->required();
+  sub->add_option("--lever-arm", args->lever_arm_m,
+                  "left camera position in the body frame x y z (m)")
+      ->expected(3);
+  sub->add_option("--pitch-down-deg", args->pitch_down_deg,
+                  "downward pitch of the left camera (degrees)");
+}
+
+void WriteImportedRig(const Rig& rig, const std::string& output) {
+  WriteRig(rig, output);
+  LOG(INFO) << "wrote " << output << " (" << rig.cameras.size() << " cameras)";
+}
+
+CsvTrajectoryFormat CsvFormatOf(const TrajectoryArguments& args) {
+  CsvTrajectoryFormat format;
+  format.angle_unit =
+      args.angles == "rad" ? AngleUnit::kRadians : AngleUnit::kDegrees;
+  format.time_kind = args.time == "utc"           ? TimeKind::kUtc
+                     : args.time == "gps-seconds" ? TimeKind::kGpsSeconds
+                                                  : TimeKind::kGpsWeekSeconds;
+  format.delimiter = args.delimiter == "whitespace"  ? Delimiter::kWhitespace
+                     : args.delimiter == "semicolon" ? Delimiter::kSemicolon
+                                                     : Delimiter::kComma;
+  format.leap_seconds_file = args.leap_seconds;
+  format.crs = args.crs;
+  format.grid_dirs = args.grid_dirs;
+  if (!args.columns.empty()) {
+    const std::string error = ParseColumnMap(args.columns, &format);
+    if (!error.empty()) throw UsageError("--columns: " + error);
+  }
+  return format;
+}
+
+std::vector<TrajectorySample> ReadTrajectory(const TrajectoryArguments& args) {
+  if (args.format == "sbet") return ReadSbet(args.input, args.smrmsg);
+  if (!args.smrmsg.empty()) {
+    throw UsageError("--smrmsg goes with --format sbet only");
+  }
+  return args.format == "novatel"
+             ? ReadNovatelAscii(args.input)
+             : ReadTrajectoryCsv(args.input, CsvFormatOf(args));
+}
+
+void RunImportTrajectory(const TrajectoryArguments& args) {
+  if (!args.crs.empty() && args.format != "csv") {
+    throw UsageError(
+        "--crs goes with --format csv only (SBET and NovAtel "
+        "logs are WGS84)");
+  }
+  std::vector<TrajectorySample> samples;
+  try {
+    samples = ReadTrajectory(args);
+  } catch (const CrsError& error) {
+    throw UsageError(std::string("--crs: ") + error.what());
+  }
+  WriteTrajectorySamples(samples, args.output);
+  LOG(INFO) << "wrote " << args.output << " (" << samples.size()
+            << " samples, GPS seconds of week " << samples.front().time
+            << " to " << samples.back().time << ")";
+}
+
 }  // namespace
+
+void AddImportCalibrationCommands(CLI::App* app,
+                                  std::vector<Command>* commands) {
+  {
+    auto args = std::make_shared<ImportArguments>();
+    CLI::App* sub = app->add_subcommand(
+        "import-kalibr",
+        "Convert a Kalibr camchain.yaml (pinhole, radtan or equidistant) to "
+        "rig.yaml. cam0 is mounted looking forward, pitched down by "
+        "--pitch-down-deg, at --lever-arm (body FRD, metres); the others "
+        "follow from T_cn_cnm1.");
+    sub->add_option("camchain", args->calibration, "Kalibr camchain.yaml")
+        ->required()
+        ->check(CLI::ExistingFile);
+    AddMountOptions(sub, args.get());
+    sub->add_option("--max-fit-error-px", args->options.max_fit_error_px,
+                    "largest error of the OpenCV model fitted to an "
+                    "equidistant one (pixels)")
+        ->capture_default_str();
+    commands->push_back(
+        {sub, [args] {
+           WriteImportedRig(
+               ImportKalibrCamchain(
+                   args->calibration,
+                   ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg),
+                   args->options),
+               args->output);
+         }});
+  }
+  {
+    auto args = std::make_shared<ImportArguments>();
+    CLI::App* sub = app->add_subcommand(
+        "import-ros-camera-info",
+        "Convert a left and a right ROS camera_info YAML (from "
+        "camera_calibration's stereo calibration) to rig.yaml, the left "
+        "camera mounted as for import-opencv-stereo.");
+    sub->add_option("left", args->calibration, "left camera_info YAML")
+        ->required()
+        ->check(CLI::ExistingFile);
+    sub->add_option("right", args->right_calibration, "right camera_info YAML")
+        ->required()
+        ->check(CLI::ExistingFile);
+    AddMountOptions(sub, args.get());
+    sub->add_option("--max-fit-error-px", args->options.max_fit_error_px,
+                    "largest error of the OpenCV model fitted to an "
+                    "equidistant one (pixels)")
+        ->capture_default_str();
+    commands->push_back(
+        {sub, [args] {
+           WriteImportedRig(
+               ImportRosCameraInfoPair(
+                   args->calibration, args->right_calibration,
+                   ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg),
+                   args->options),
+               args->output);
+         }});
+  }
+}
+
+void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands) {
+  auto args = std::make_shared<TrajectoryArguments>();
+  CLI::App* sub = app->add_subcommand(
+      "import-trajectory",
+      "Convert a GNSS/INS trajectory (Applanix SBET with its smrmsg, NovAtel "
+      "SPAN INSPVAXA/INSPVAA ASCII log, or a delimited text export with a "
+      "column map) to the survey's trajectory.csv. Time is written as GPS "
+      "seconds of week (of the first record's week): exposures.csv must use "
+      "the same clock.");
+  sub->add_option("input", args->input, "trajectory file")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--format", args->format, "sbet, novatel or csv")
+      ->required()
+      ->check(CLI::IsMember({"sbet", "novatel", "csv"}));
+  sub->add_option("-o,--output", args->output, "trajectory.csv to write")
+      ->required();
+  sub->add_option("--smrmsg", args->smrmsg,
+                  "sbet: the smrmsg accuracy file (for the sd_* columns)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--columns", args->columns,
+                  "csv: NAME=COLUMN,... for time, lat, lon, h, roll, pitch, "
+                  "heading, sd_e, sd_n, sd_u, sd_roll, sd_pitch, sd_heading "
+                  "(unmapped names are looked up as themselves)");
+  sub->add_option("--angles", args->angles,
+                  "csv: unit of lat, lon and the attitude: deg or rad")
+      ->check(CLI::IsMember({"deg", "rad"}))
+      ->capture_default_str();
+  sub->add_option("--time", args->time,
+                  "csv: week-seconds (GPS), gps-seconds (since 1980-01-06) "
+                  "or utc (ISO 8601, converted with leap seconds)")
+      ->check(CLI::IsMember({"week-seconds", "gps-seconds", "utc"}))
+      ->capture_default_str();
+  sub->add_option("--delimiter", args->delimiter,
+                  "csv: comma, whitespace or semicolon")
+      ->check(CLI::IsMember({"comma", "whitespace", "semicolon"}))
+      ->capture_default_str();
+  sub->add_option("--leap-seconds", args->leap_seconds,
+                  "csv --time utc: IERS leap-seconds.list")
+      ->capture_default_str();
+  sub->add_option("--crs", args->crs,
+                  "csv: CRS of the positions (EPSG code, compound code with a "
+                  "geoid, PROJ string): columns x, y, h instead of lat, lon, "
+                  "h, transformed to WGS84 by PROJ");
+  sub->add_option("--grid-dir", args->grid_dirs,
+                  "csv --crs: a folder holding PROJ grids (geoid models), "
+                  "searched first");
+  commands->push_back({sub, [args] { RunImportTrajectory(*args); }});
+}
 
 void AddImportOpenCvStereoCommand(CLI::App* app,
                                   std::vector<Command>* commands) {
@@ -54,24 +249,18 @@ void AddImportOpenCvStereoCommand(CLI::App* app,
   sub->add_option("calibration", args->calibration, "OpenCV FileStorage file")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("-o,--output", args->output, "rig.yaml to write")->required();
   sub->add_option("--width", args->width,
                   "image width in pixels (if not in the file)");
   sub->add_option("--height", args->height,
                   "image height in pixels (if not in the file)");
-  sub->add_option("--lever-arm", args->lever_arm_m,
-                  "left camera position in the body frame x y z (m)")
-      ->expected(3);
-  sub->add_option("--pitch-down-deg", args->pitch_down_deg,
-                  "downward pitch of the left camera (degrees)");
+  AddMountOptions(sub, args.get());
   commands->push_back(
       {sub, [args] {
-         const Rig rig = ImportOpenCvStereo(
-             args->calibration, args->width, args->height,
-             ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg));
-         WriteRig(rig, args->output);
-         LOG(INFO) << "wrote " << args->output << " (" << rig.cameras.size()
-                   << " cameras)";
+         WriteImportedRig(
+             ImportOpenCvStereo(
+                 args->calibration, args->width, args->height,
+                 ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg)),
+             args->output);
        }});
 }
 

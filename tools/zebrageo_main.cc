@@ -59,6 +59,9 @@ int Main(int argc, char** argv) {
   AddAdjustCommand(&app, &commands);
   AddRunCommands(&app, &commands);
   AddImportOpenCvStereoCommand(&app, &commands);
+  AddImportCalibrationCommands(&app, &commands);
+  AddImportTrajectoryCommand(&app, &commands);
+  AddExportGcpCommand(&app, &commands);
 
   try {
     app.parse(argc, argv);

@@ -7,12 +7,12 @@
 #include <random>
 #include <set>
 
+#include "survey/math_util.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kBandWidthM = 0.5;
 constexpr double kBandPeriodM = 1.0;
 constexpr double kBodyHeightM = 1.0;  // body origin above the road

@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "survey/math_util.h"
 #include "survey/trajectory.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 // Independent WGS84 geodesy, written from the textbook formulas and sharing

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
@@ -17,7 +18,6 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 const Geodetic kStart{49.8941, 2.2958, 60.0};
 

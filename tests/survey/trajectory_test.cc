@@ -8,6 +8,7 @@
 #include <string>
 
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -15,7 +16,6 @@ namespace {
 
 using ::testing::HasSubstr;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 const char kHeader[] =
     "time,lat,lon,h,roll,pitch,heading,sd_e,sd_n,sd_u,sd_roll,sd_pitch,"
