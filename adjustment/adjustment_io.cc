@@ -313,8 +313,8 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
     return (fs::path(survey_folder) / name).string();
   };
   data.rig = ReadRig(path_of(data.manifest.rig), data.manifest.rig);
-  std::vector<TrajectorySample> samples = ReadTrajectorySamples(
-      path_of(data.manifest.trajectory), data.manifest.trajectory);
+  std::vector<TrajectorySample> samples =
+      ReadSurveyTrajectory(survey_folder, data.manifest);
   data.frame =
       LocalFrame(data.manifest.origin.value_or(samples.front().position));
   data.trajectory = Trajectory(std::move(samples), data.frame);
@@ -337,8 +337,8 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
                             std::to_string(data.exposures.images.size()) +
                             " images are missing: no tie points in them");
   }
-  data.roadmarks =
-      ReadRoadmarks(path_of(data.manifest.roadmarks), data.manifest.roadmarks);
+  data.roadmarks = ReadSurveyRoadmarks(survey_folder, data.manifest,
+                                       data.trajectory.samples());
   data.vertices = ReadReconstructedBands(
       RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct"),
       kReconstructedBandsFile);

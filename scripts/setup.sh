@@ -13,6 +13,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev
   libproj-dev proj-bin proj-data
+  postgresql postgresql-client postgresql-15-postgis-3
   python3 python3-numpy python3-opencv python3-yaml
   chromium
 )

@@ -545,6 +545,10 @@ std::string SigmaText(double sigma) {
 
 }  // namespace
 
+std::string BandDegeneracy(const std::array<Geodetic, 4>& corners) {
+  return DegeneracyOf(corners);
+}
+
 RoadmarkDatabase ParseRoadmarks(const std::string& text,
                                 const std::string& display_name) {
   return RoadmarkParser(text, display_name).Parse();

@@ -25,6 +25,9 @@ struct RoadmarkBand {
   std::array<Geodetic, 4> corners;
   double sigma_xy_m = 0.0;
   double sigma_z_m = 0.0;
+  // False for a band of a 2D layer (survey/roadmark_layer.h): its corners'
+  // heights are a guess, with a wide sigma_z_m.
+  bool height_known = true;
 };
 
 struct RoadmarkLine {
@@ -50,6 +53,9 @@ RoadmarkDatabase ReadRoadmarks(const std::string& path,
                                const std::string& display_name);
 RoadmarkDatabase ParseRoadmarks(const std::string& text,
                                 const std::string& display_name);
+// "" or why four corners make no usable band (repeated corners, zero area,
+// self-intersecting), as ReadRoadmarks checks each band.
+std::string BandDegeneracy(const std::array<Geodetic, 4>& corners);
 // Writes a database atomically: rings closed, corners in the stored order,
 // one feature per line, numbers with every digit (round trip exact).
 void WriteRoadmarks(const RoadmarkDatabase& database, const std::string& path);

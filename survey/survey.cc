@@ -3,10 +3,12 @@
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -46,6 +48,109 @@ std::string FileKey(const YAML::Node& root, const char* key,
                    file.Problem());
   }
   return name;
+}
+
+// An optional CRS key: PROJ must know it (the grids are checked when the
+// survey is loaded, with the grid folders).
+SurveyCrs CrsKey(const YAML::Node& root, const char* key) {
+  SurveyCrs crs;
+  const YAML::Node node = root[key];
+  if (!node || node.IsNull()) return crs;
+  if (!node.IsScalar() || node.Scalar().empty()) {
+    Fail(node, std::string("'") + key +
+                   "' must be a CRS: an EPSG code (\"EPSG:2154\", "
+                   "\"EPSG:2154+5720\"), a PROJ string or WKT");
+  }
+  crs.definition = node.Scalar();
+  crs.line = LineOf(node);
+  try {
+    Crs parsed(crs.definition);
+  } catch (const CrsError& error) {
+    Fail(node, std::string("'") + key + "': " + error.what());
+  }
+  return crs;
+}
+
+std::vector<std::string> GridDirsKey(const YAML::Node& root,
+                                     const SurveyPaths& paths) {
+  std::vector<std::string> folders;
+  const YAML::Node node = root["crs_grid_dirs"];
+  if (!node || node.IsNull()) return folders;
+  if (!node.IsSequence()) {
+    Fail(node, "'crs_grid_dirs' must be a list of folders");
+  }
+  for (const YAML::Node& item : node) {
+    if (!item.IsScalar() || item.Scalar().empty()) {
+      Fail(item, "'crs_grid_dirs' must be a list of folder names");
+    }
+    const SurveyFile folder = paths.Resolve(item.Scalar());
+    if (folder.escapes()) {
+      Fail(item, "'crs_grid_dirs' names " + item.Scalar() + ", which " +
+                     folder.Problem());
+    }
+    if (!fs::is_directory(folder.path)) {
+      Fail(item, "'crs_grid_dirs' names " + item.Scalar() +
+                     ", which is not a folder");
+    }
+    folders.push_back(item.Scalar());
+  }
+  return folders;
+}
+
+// "PG:dbname=..." names a PostGIS database, not a file.
+bool IsDatabaseConnection(const YAML::Node& node) {
+  return node && node.IsScalar() && node.Scalar().rfind("PG:", 0) == 0;
+}
+
+std::string StringKey(const YAML::Node& node, const std::string& key) {
+  if (!node || node.IsNull()) return "";
+  if (!node.IsScalar() || node.Scalar().empty()) {
+    Fail(node, "'" + key + "' must be a non-empty string");
+  }
+  return node.Scalar();
+}
+
+void ReadRoadmarkLayerKeys(const YAML::Node& root, SurveyManifest* manifest) {
+  manifest->roadmarks_layer =
+      StringKey(root["roadmarks_layer"], "roadmarks_layer");
+  const YAML::Node fields = root["roadmarks_fields"];
+  if (fields && !fields.IsNull()) {
+    if (!fields.IsMap()) {
+      Fail(fields,
+           "'roadmarks_fields' must map crossing_id, band, sigma_xy, "
+           "sigma_z, type to the layer's attribute names");
+    }
+    RoadmarkFields& f = manifest->roadmarks_fields;
+    const std::pair<const char*, std::string*> known[] = {
+        {"crossing_id", &f.crossing_id},
+        {"band", &f.band},
+        {"sigma_xy", &f.sigma_xy},
+        {"sigma_z", &f.sigma_z},
+        {"type", &f.type}};
+    for (const auto& entry : fields) {
+      const std::string key = entry.first.Scalar();
+      bool found = false;
+      for (const auto& [name, target] : known) {
+        if (key != name) continue;
+        *target = StringKey(entry.second, "roadmarks_fields." + key);
+        found = true;
+      }
+      if (!found) {
+        Fail(entry.first, "'roadmarks_fields' has no key '" + key +
+                              "' (crossing_id, band, sigma_xy, sigma_z, "
+                              "type)");
+      }
+    }
+  }
+  const YAML::Node margin = root["roadmarks_margin_m"];
+  if (margin && !margin.IsNull()) {
+    double value = 0.0;
+    if (!margin.IsScalar() || !YAML::convert<double>::decode(margin, value) ||
+        !std::isfinite(value) || value <= 0.0) {
+      Fail(margin, "'roadmarks_margin_m' must be a number of metres > 0");
+    }
+    manifest->roadmarks_margin_m = value;
+  }
 }
 
 Geodetic ParseOrigin(const YAML::Node& node) {
@@ -144,12 +249,28 @@ SurveyManifest ReadManifest(const std::string& survey_folder,
   manifest.rig = FileKey(root, "rig", paths);
   manifest.trajectory = FileKey(root, "trajectory", paths);
   manifest.exposures = FileKey(root, "exposures", paths);
-  manifest.roadmarks = FileKey(root, "roadmarks", paths);
+  // A database is outside the survey folder: like a file there, only for
+  // a trusted survey (a survey from someone else must not make zebrageo
+  // connect to a server of its choosing).
+  if (IsDatabaseConnection(root["roadmarks"]) &&
+      !path_options.allow_outside_paths) {
+    Fail(root["roadmarks"],
+         "'roadmarks' names a PostGIS database, outside the survey folder: "
+         "pass --allow-outside-paths for a survey you trust");
+  }
+  manifest.roadmarks = IsDatabaseConnection(root["roadmarks"])
+                           ? root["roadmarks"].Scalar()
+                           : FileKey(root, "roadmarks", paths);
+  ReadRoadmarkLayerKeys(root, &manifest);
   const YAML::Node origin = root["origin"];
   if (origin && !origin.IsNull()) {
     manifest.origin = ParseOrigin(origin);
     manifest.origin_line = LineOf(origin);
   }
+  manifest.roadmarks_crs = CrsKey(root, "roadmarks_crs");
+  manifest.trajectory_crs = CrsKey(root, "trajectory_crs");
+  manifest.output_crs = CrsKey(root, "output_crs");
+  manifest.crs_grid_dirs = GridDirsKey(root, paths);
   return manifest;
 }
 
@@ -171,6 +292,42 @@ void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
         << FormatDouble(o.lon_deg) << ", " << FormatDouble(o.h_m)
         << "]  # lat, lon, h of the ENU origin\n";
   }
+  const std::pair<const char*, const SurveyCrs*> crs_keys[] = {
+      {"roadmarks_crs", &manifest.roadmarks_crs},
+      {"trajectory_crs", &manifest.trajectory_crs},
+      {"output_crs", &manifest.output_crs}};
+  for (const auto& [key, crs] : crs_keys) {
+    if (crs->is_set()) {
+      out << key << ": " << YamlString(crs->definition) << "\n";
+    }
+  }
+  if (!manifest.roadmarks_layer.empty()) {
+    out << "roadmarks_layer: " << YamlString(manifest.roadmarks_layer) << "\n";
+  }
+  const RoadmarkFields& f = manifest.roadmarks_fields;
+  const std::pair<const char*, const std::string*> fields[] = {
+      {"crossing_id", &f.crossing_id},
+      {"band", &f.band},
+      {"sigma_xy", &f.sigma_xy},
+      {"sigma_z", &f.sigma_z},
+      {"type", &f.type}};
+  bool fields_header = false;
+  for (const auto& [key, name] : fields) {
+    if (name->empty()) continue;
+    if (!fields_header) out << "roadmarks_fields:\n";
+    fields_header = true;
+    out << "  " << key << ": " << YamlString(*name) << "\n";
+  }
+  if (manifest.roadmarks_margin_m != SurveyManifest().roadmarks_margin_m) {
+    out << "roadmarks_margin_m: " << FormatDouble(manifest.roadmarks_margin_m)
+        << "\n";
+  }
+  if (!manifest.crs_grid_dirs.empty()) {
+    out << "crs_grid_dirs:\n";
+    for (const std::string& folder : manifest.crs_grid_dirs) {
+      out << "  - " << YamlString(folder) << "\n";
+    }
+  }
   file.Commit();
 }
 
@@ -191,6 +348,108 @@ std::string Survey::PathOf(const std::string& relative) const {
   return (fs::path(folder) / relative).string();
 }
 
+CrsOptions SurveyCrsOptions(const std::string& survey_folder,
+                            const SurveyManifest& manifest) {
+  CrsOptions options;
+  for (const std::string& folder_name : manifest.crs_grid_dirs) {
+    options.grid_dirs.push_back(
+        fs::absolute(fs::path(survey_folder) / folder_name).string());
+  }
+  return options;
+}
+
+CrsTransformer MakeSurveyCrsTransformer(const std::string& survey_folder,
+                                        const SurveyManifest& manifest,
+                                        const SurveyCrs& crs,
+                                        const std::string& key) {
+  try {
+    return CrsTransformer(Crs(crs.definition),
+                          SurveyCrsOptions(survey_folder, manifest));
+  } catch (const CrsError& error) {
+    throw InputError(kManifestFile, crs.line, key + ": " + error.what());
+  }
+}
+
+std::vector<TrajectorySample> ReadSurveyTrajectory(
+    const std::string& survey_folder, const SurveyManifest& manifest) {
+  const std::string path =
+      (fs::path(survey_folder) / manifest.trajectory).string();
+  if (!manifest.trajectory_crs.is_set()) {
+    return ReadTrajectorySamples(path, manifest.trajectory);
+  }
+  return ReadTrajectorySamplesInCrs(
+      path, manifest.trajectory,
+      MakeSurveyCrsTransformer(survey_folder, manifest, manifest.trajectory_crs,
+                               "trajectory_crs"));
+}
+
+bool SurveyManifest::RoadmarksThroughGdal() const {
+  std::string extension = fs::path(roadmarks).extension().string();
+  for (char& c : extension) {
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  const RoadmarkFields& f = roadmarks_fields;
+  return roadmarks.rfind("PG:", 0) == 0 || roadmarks_crs.is_set() ||
+         !roadmarks_layer.empty() || !f.crossing_id.empty() ||
+         !f.band.empty() || !f.sigma_xy.empty() || !f.sigma_z.empty() ||
+         !f.type.empty() || (extension != ".geojson" && extension != ".json");
+}
+
+namespace {
+
+// The road's height below the trajectory, for 2D layers: the nearest
+// sample's height less a nominal IMU height over the road. A guess: such
+// bands get a sigma_z of metres, and the adjustment takes their heights
+// from the reconstruction.
+constexpr double kNominalImuHeightM = 1.5;
+
+double RoadHeightBelow(const std::vector<TrajectorySample>& trajectory,
+                       double lat_deg, double lon_deg) {
+  double best = std::numeric_limits<double>::infinity();
+  double height = 0.0;
+  const double scale = std::cos(lat_deg * 3.14159265358979323846 / 180.0);
+  for (const TrajectorySample& s : trajectory) {
+    const double dlat = s.position.lat_deg - lat_deg;
+    const double dlon = (s.position.lon_deg - lon_deg) * scale;
+    const double d2 = dlat * dlat + dlon * dlon;
+    if (d2 < best) {
+      best = d2;
+      height = s.position.h_m - kNominalImuHeightM;
+    }
+  }
+  return height;
+}
+
+}  // namespace
+
+RoadmarkDatabase ReadSurveyRoadmarks(
+    const std::string& survey_folder, const SurveyManifest& manifest,
+    const std::vector<TrajectorySample>& trajectory) {
+  if (!manifest.RoadmarksThroughGdal()) {
+    return ReadRoadmarks(
+        (fs::path(survey_folder) / manifest.roadmarks).string(),
+        manifest.roadmarks);
+  }
+  RoadmarkLayerOptions options;
+  const bool database = manifest.roadmarks.rfind("PG:", 0) == 0;
+  options.source =
+      database ? manifest.roadmarks
+               : (fs::path(survey_folder) / manifest.roadmarks).string();
+  options.layer = manifest.roadmarks_layer;
+  options.crs = manifest.roadmarks_crs.definition;
+  options.crs_options = SurveyCrsOptions(survey_folder, manifest);
+  options.fields = manifest.roadmarks_fields;
+  std::vector<Geodetic> positions;
+  for (const TrajectorySample& s : trajectory) positions.push_back(s.position);
+  if (!positions.empty()) {
+    options.area = BoxAround(positions, manifest.roadmarks_margin_m);
+  }
+  options.height_guess = [&trajectory](double lat_deg, double lon_deg) {
+    return RoadHeightBelow(trajectory, lat_deg, lon_deg);
+  };
+  return ReadRoadmarkLayer(options, manifest.roadmarks);
+}
+
 Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
   const std::string problem = options.Check();
   if (!problem.empty()) {
@@ -208,8 +467,15 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
                      "no stereo_pairs: zebrageo needs at least one stereo "
                      "pair to reconstruct road marks");
   }
-  std::vector<TrajectorySample> samples = ReadTrajectorySamples(
-      survey.PathOf(manifest.trajectory), manifest.trajectory);
+  // Every CRS is checked here, output_crs included: a missing grid stops
+  // the survey before hours of processing, not at the last file written.
+  for (const auto& [key, crs] :
+       {std::pair{"roadmarks_crs", &manifest.roadmarks_crs},
+        std::pair{"output_crs", &manifest.output_crs}}) {
+    if (crs->is_set()) MakeSurveyCrsTransformer(folder, manifest, *crs, key);
+  }
+  std::vector<TrajectorySample> samples =
+      ReadSurveyTrajectory(folder, manifest);
   const Geodetic origin = manifest.origin.value_or(samples.front().position);
   survey.frame = LocalFrame(origin);
   survey.trajectory = Trajectory(std::move(samples), survey.frame);
@@ -290,7 +556,24 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
 
   if (options.load_roadmarks) {
     survey.roadmarks =
-        ReadRoadmarks(survey.PathOf(manifest.roadmarks), manifest.roadmarks);
+        ReadSurveyRoadmarks(folder, manifest, survey.trajectory.samples());
+  }
+
+  if (options.load_roadmarks) {
+    const long flat = std::count_if(
+        survey.roadmarks.bands.begin(), survey.roadmarks.bands.end(),
+        [](const RoadmarkBand& band) { return !band.height_known; });
+    if (flat > 0) {
+      const std::string warning =
+          manifest.roadmarks + ": " + std::to_string(flat) +
+          " bands without heights (a 2D layer): given the trajectory's "
+          "height less 1.5 m with sigma_z " +
+          FormatDouble(RoadmarkLayerOptions().sigma_z_without_height_m) +
+          " m, so their heights come from the reconstruction and the "
+          "database controls no height";
+      LOG(WARNING) << warning;
+      survey.warnings.push_back(warning);
+    }
   }
 
   PlausibilityInput plausibility;

@@ -7,15 +7,24 @@
 #include <string>
 #include <vector>
 
+#include "survey/crs.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/plausibility.h"
 #include "survey/rig.h"
+#include "survey/roadmark_layer.h"
 #include "survey/roadmarks.h"
 #include "survey/survey_paths.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
+
+// A CRS named in survey.yaml, with its line for messages.
+struct SurveyCrs {
+  std::string definition;  // empty: WGS84 as in the contract
+  int line = 0;
+  bool is_set() const { return !definition.empty(); }
+};
 
 struct SurveyManifest {
   std::string name;
@@ -25,6 +34,25 @@ struct SurveyManifest {
   std::string roadmarks = "roadmarks.geojson";
   std::optional<Geodetic> origin;  // default: the first trajectory sample
   int origin_line = 0;             // in survey.yaml, for messages
+
+  // Optional CRSs (survey/crs.h: an EPSG code, "EPSG:2154+5720", a PROJ
+  // string, WKT). Empty: the contract's WGS84 (lat, lon, ellipsoidal h),
+  // and every file exactly as SURVEY_FORMAT.md says.
+  SurveyCrs roadmarks_crs;   // of the road-mark database's coordinates
+  SurveyCrs trajectory_crs;  // of trajectory.csv (columns x, y, z)
+  SurveyCrs output_crs;      // added to every output carrying coordinates
+  // Folders (relative to the survey folder) searched for geoid and datum
+  // grids before PROJ's own; `crs_grid_dirs` in survey.yaml.
+  std::vector<std::string> crs_grid_dirs;
+  // A road-mark layer read through GDAL/OGR (survey/roadmark_layer.h):
+  // `roadmarks` may then be any vector file or a "PG:..." connection.
+  std::string roadmarks_layer;        // the layer or table; "": the only one
+  RoadmarkFields roadmarks_fields;    // attribute names; "": guessed
+  double roadmarks_margin_m = 200.0;  // read only around the trajectory
+
+  // Whether the database is read through GDAL (anything but a plain
+  // GeoJSON of the contract).
+  bool RoadmarksThroughGdal() const;
 };
 
 // Reads survey.yaml (a leading UTF-8 byte-order mark is allowed). Throws
@@ -72,6 +100,34 @@ struct Survey {
   // Absolute path of a file named relative to the survey folder.
   std::string PathOf(const std::string& relative) const;
 };
+
+// The grid folders of survey.yaml (`crs_grid_dirs`), as absolute paths, for
+// CrsTransformer.
+CrsOptions SurveyCrsOptions(const std::string& survey_folder,
+                            const SurveyManifest& manifest);
+
+// The transformer of a CRS named in survey.yaml. Throws InputError naming
+// survey.yaml, the key's line and PROJ's problem (an unknown CRS, a missing
+// grid).
+CrsTransformer MakeSurveyCrsTransformer(const std::string& survey_folder,
+                                        const SurveyManifest& manifest,
+                                        const SurveyCrs& crs,
+                                        const std::string& key);
+
+// The survey's trajectory in WGS84: trajectory.csv as the contract says,
+// or, with `trajectory_crs`, its x, y, z columns converted (every stage
+// reads the trajectory through this).
+std::vector<TrajectorySample> ReadSurveyTrajectory(
+    const std::string& survey_folder, const SurveyManifest& manifest);
+
+// The survey's road-mark database in WGS84 (every stage reads it through
+// this): the contract's GeoJSON reader for a plain survey; a layer read
+// through GDAL/OGR (survey/roadmark_layer.h) when the manifest names a
+// CRS, a layer or attribute map, or a file or PG: source that is not
+// GeoJSON. `trajectory` bounds what is read from a large table.
+RoadmarkDatabase ReadSurveyRoadmarks(
+    const std::string& survey_folder, const SurveyManifest& manifest,
+    const std::vector<TrajectorySample>& trajectory);
 
 // Loads and cross-validates a survey. Throws InputError: everything the
 // individual readers reject, plus exposures outside the trajectory's time

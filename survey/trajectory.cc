@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "survey/atomic_file.h"
+#include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
@@ -22,16 +23,39 @@ const std::vector<std::string>& TrajectoryColumns() {
   return kColumns;
 }
 
-std::vector<TrajectorySample> SamplesFromTable(const CsvTable& table) {
+// The columns of a trajectory whose positions are x, y, z of another CRS.
+std::vector<std::string> TrajectoryColumnsInCrs() {
+  std::vector<std::string> columns = TrajectoryColumns();
+  columns[1] = "x";
+  columns[2] = "y";
+  columns[3] = "z";
+  return columns;
+}
+
+// `crs`: null for the contract's lat, lon, h columns; else the columns x, y,
+// z of that CRS, converted to WGS84 here.
+std::vector<TrajectorySample> SamplesFromTable(
+    const CsvTable& table, const CrsTransformer* crs = nullptr) {
   std::vector<TrajectorySample> samples;
   samples.reserve(table.NumRows());
   for (int row = 0; row < table.NumRows(); ++row) {
     TrajectorySample s;
     s.line = table.LineOf(row);
     s.time = table.GetDouble(row, "time");
-    s.position.lat_deg = table.GetDouble(row, "lat");
-    s.position.lon_deg = table.GetDouble(row, "lon");
-    s.position.h_m = table.GetDouble(row, "h");
+    if (crs == nullptr) {
+      s.position.lat_deg = table.GetDouble(row, "lat");
+      s.position.lon_deg = table.GetDouble(row, "lon");
+      s.position.h_m = table.GetDouble(row, "h");
+    } else {
+      const Eigen::Vector3d xyz(table.GetDouble(row, "x"),
+                                table.GetDouble(row, "y"),
+                                table.GetDouble(row, "z"));
+      try {
+        s.position = crs->ToWgs84(xyz);
+      } catch (const CrsError& error) {
+        table.Fail(row, error.what());
+      }
+    }
     s.attitude.roll = table.GetDouble(row, "roll") * kDegToRad;
     s.attitude.pitch = table.GetDouble(row, "pitch") * kDegToRad;
     s.attitude.heading = table.GetDouble(row, "heading") * kDegToRad;
@@ -186,6 +210,13 @@ std::vector<TrajectorySample> ReadTrajectorySamples(
     const std::string& path, const std::string& display_name) {
   return SamplesFromTable(
       CsvTable::Read(path, display_name, TrajectoryColumns()));
+}
+
+std::vector<TrajectorySample> ReadTrajectorySamplesInCrs(
+    const std::string& path, const std::string& display_name,
+    const CrsTransformer& crs) {
+  return SamplesFromTable(
+      CsvTable::Read(path, display_name, TrajectoryColumnsInCrs()), &crs);
 }
 
 std::vector<TrajectorySample> ParseTrajectorySamples(

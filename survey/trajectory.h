@@ -19,6 +19,8 @@
 
 namespace zebrageo {
 
+class CrsTransformer;
+
 struct TrajectorySample {
   double time = 0.0;  // seconds, the survey's clock
   Geodetic position;
@@ -106,6 +108,16 @@ std::vector<double> SampleTimes(const std::vector<TrajectorySample>& samples);
 // samples, times not strictly increasing (duplicates included).
 std::vector<TrajectorySample> ReadTrajectorySamples(
     const std::string& path, const std::string& display_name);
+// The same file with positions in another CRS (survey.yaml's
+// `trajectory_crs`): columns x, y, z in place of lat, lon, h, in the CRS's
+// units and east-first order (survey/crs.h: easting, northing, height; or
+// longitude, latitude, height). Attitude, heading from true north, and the
+// standard deviations are as in trajectory.csv. Positions are converted to
+// WGS84 as they are read; a point PROJ cannot convert is an InputError on
+// its line.
+std::vector<TrajectorySample> ReadTrajectorySamplesInCrs(
+    const std::string& path, const std::string& display_name,
+    const CrsTransformer& crs);
 std::vector<TrajectorySample> ParseTrajectorySamples(
     const std::string& text, const std::string& display_name);
 // Writes samples in the same format, angles normalised (heading [0, 360),

@@ -13,6 +13,7 @@
 #include "adjustment/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "survey/atomic_file.h"
+#include "survey/output_crs.h"
 #include "survey/results.h"
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
@@ -141,6 +142,8 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
               << " vertex matches rejected by the adjustment removed from "
               << kMatchesFile;
   }
+  // survey.yaml's output_crs, beside the contract's WGS84 and ENU columns.
+  AddOutputCrs(survey, results_folder);
   LOG(INFO) << "adjust: " << result.summary.BriefReport();
   return warnings;
 }

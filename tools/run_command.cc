@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "registration/match_stage.h"
+#include "survey/output_crs.h"
 #include "survey/results.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
@@ -123,7 +124,12 @@ void Run(const RunArguments& args) {
                       if (rematch.disagreements > 0) {
                         warnings.push_back(rematch.message);
                       }
-                      if (rematch.added == 0) return warnings;
+                      if (rematch.added == 0) {
+                        // The rematch rewrote matches.csv: its output_crs
+                        // columns again.
+                        AddOutputCrs(survey, results);
+                        return warnings;
+                      }
                       return RunAdjustStage(survey, results, adjustment,
                                             args.tie_points, args.lines);
                     }});
