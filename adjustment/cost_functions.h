@@ -44,6 +44,31 @@ constexpr int kRigCorrectionSize = 6;
 // at t (6), the point (3) and the camera's mounting correction (6);
 // SplineReprojectionCost chains it to the 4 knots (dr/dk_j = w_j dr/dc) so
 // automatic differentiation runs on 15 dimensions instead of 33.
+// X_body = R_ins^T Exp(-dtheta) (X_enu - p_ins - dp): an ENU point in the
+// body frame of the corrected trajectory at one time (see above), shared by
+// the reprojection and the stereo-vertex residuals.
+template <typename T>
+void CorrectedBodyPoint(const T* c, const T* point_enu,
+                        const Eigen::Vector3d& p_enu_ins,
+                        const Eigen::Matrix3d& R_enu_track,
+                        const Eigen::Matrix3d& R_body_enu_ins, T* x_body) {
+  T d[3];
+  T minus_dtheta[3];
+  for (int i = 0; i < 3; ++i) {
+    d[i] = point_enu[i] - p_enu_ins[i] -
+           (R_enu_track(i, 0) * c[3] + R_enu_track(i, 1) * c[4] +
+            R_enu_track(i, 2) * c[5]);
+    minus_dtheta[i] = -(R_enu_track(i, 0) * c[0] + R_enu_track(i, 1) * c[1] +
+                        R_enu_track(i, 2) * c[2]);
+  }
+  T v[3];
+  ceres::AngleAxisRotatePoint(minus_dtheta, d, v);
+  for (int r = 0; r < 3; ++r) {
+    x_body[r] = R_body_enu_ins(r, 0) * v[0] + R_body_enu_ins(r, 1) * v[1] +
+                R_body_enu_ins(r, 2) * v[2];
+  }
+}
+
 class PoseReprojectionError {
  public:
   PoseReprojectionError(const Eigen::Vector2d& uv,
@@ -65,23 +90,12 @@ class PoseReprojectionError {
   template <typename T>
   bool operator()(const T* const c, const T* const point_enu,
                   const T* const rig_correction, T* residuals) const {
-    T d[3];
-    T minus_dtheta[3];
-    for (int i = 0; i < 3; ++i) {
-      d[i] = point_enu[i] - p_enu_ins_[i] -
-             (R_enu_track_(i, 0) * c[3] + R_enu_track_(i, 1) * c[4] +
-              R_enu_track_(i, 2) * c[5]);
-      minus_dtheta[i] =
-          -(R_enu_track_(i, 0) * c[0] + R_enu_track_(i, 1) * c[1] +
-            R_enu_track_(i, 2) * c[2]);
-    }
-    T v[3];
-    ceres::AngleAxisRotatePoint(minus_dtheta, d, v);
+    T x_body[3];
+    CorrectedBodyPoint(c, point_enu, p_enu_ins_, R_enu_track_, R_body_enu_ins_,
+                       x_body);
     T y[3];
     for (int r = 0; r < 3; ++r) {
-      y[r] = R_body_enu_ins_(r, 0) * v[0] + R_body_enu_ins_(r, 1) * v[1] +
-             R_body_enu_ins_(r, 2) * v[2] - t_body_cam_[r] -
-             rig_correction[3 + r];
+      y[r] = x_body[r] - t_body_cam_[r] - rig_correction[3 + r];
     }
     T z[3];
     for (int r = 0; r < 3; ++r) {
@@ -433,23 +447,11 @@ class StereoVertexError {
   template <typename T>
   bool operator()(const T* const c, const T* const point_enu,
                   T* residuals) const {
-    T d[3];
-    T minus_dtheta[3];
-    for (int i = 0; i < 3; ++i) {
-      d[i] = point_enu[i] - p_enu_ins_[i] -
-             (R_enu_track_(i, 0) * c[3] + R_enu_track_(i, 1) * c[4] +
-              R_enu_track_(i, 2) * c[5]);
-      minus_dtheta[i] =
-          -(R_enu_track_(i, 0) * c[0] + R_enu_track_(i, 1) * c[1] +
-            R_enu_track_(i, 2) * c[2]);
-    }
-    T v[3];
-    ceres::AngleAxisRotatePoint(minus_dtheta, d, v);
+    T x_body[3];
+    CorrectedBodyPoint(c, point_enu, p_enu_ins_, R_enu_track_, R_body_enu_ins_,
+                       x_body);
     T e[3];
-    for (int r = 0; r < 3; ++r) {
-      e[r] = R_body_enu_ins_(r, 0) * v[0] + R_body_enu_ins_(r, 1) * v[1] +
-             R_body_enu_ins_(r, 2) * v[2] - p_body_[r];
-    }
+    for (int r = 0; r < 3; ++r) e[r] = x_body[r] - p_body_[r];
     for (int r = 0; r < 3; ++r) {
       residuals[r] = sqrt_information_(r, 0) * e[0] +
                      sqrt_information_(r, 1) * e[1] +
