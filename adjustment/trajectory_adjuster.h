@@ -46,7 +46,6 @@
 
 #include "adjustment/line_control.h"
 #include "adjustment/solver_options.h"
-#include "adjustment/tie_points.h"
 #include "adjustment/trajectory_correction.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
@@ -54,6 +53,7 @@
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
+#include "survey/tie_tracks.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {

@@ -10,7 +10,7 @@
 #include <set>
 
 #include "adjustment/adjustment_io.h"
-#include "adjustment/tie_points.h"
+#include "tiepoints/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "survey/atomic_file.h"
 #include "survey/output_crs.h"

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "adjustment/synthetic_survey.h"
+#include "tests/support/synthetic_survey.h"
 #include "survey/results.h"
 
 namespace zebrageo {

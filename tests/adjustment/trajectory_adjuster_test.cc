@@ -8,7 +8,7 @@
 #include <set>
 
 #include "adjustment/adjustment_io.h"
-#include "adjustment/synthetic_survey.h"
+#include "tests/support/synthetic_survey.h"
 #include "survey/input_error.h"
 #include "tests/adjustment/pose_errors.h"
 #include "tests/survey/test_util.h"
