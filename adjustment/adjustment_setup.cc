@@ -40,8 +40,8 @@ Eigen::Vector2d ChooseVehicleMotion(const Context& context, State* state) {
   for (const TrajectorySample& sample : trajectory.samples()) {
     sample_times.push_back(sample.time);
   }
-  const Eigen::Vector2d stated(DegToRad(options.sideslip_sigma_deg),
-                               DegToRad(options.vertical_slip_sigma_deg));
+  const Eigen::Vector2d stated(options.sideslip_sigma_rad,
+                               options.vertical_slip_sigma_rad);
   double best_information = 0.0;
   Eigen::Vector2d best_sigma = stated;
   std::vector<VehicleMotionSample> best;
@@ -154,7 +154,7 @@ void InitialiseCorrection(const Context& context, State* state) {
       state->knot_prior.push_back(b);
     }
   }
-  if (options.sideslip_sigma_deg > 0.0) {
+  if (options.sideslip_sigma_rad > 0.0) {
     state->model.motion_sigma_rad = ChooseVehicleMotion(context, state);
   }
   context.summary->num_vehicle_motion = static_cast<int>(state->motion.size());

@@ -116,7 +116,7 @@ AdjustmentResult AdjustTrajectory(
   // The INS trajectory the correction applies to: without its jumps.
   Context context{options, input,
                   RemoveJumps(*input.trajectory, options.jump_threshold_m,
-                              DegToRad(options.jump_threshold_deg)),
+                              options.jump_threshold_rad),
                   &summary};
   summary.num_jumps = context.dejumped.num_jumps;
   if (summary.num_jumps > 0) {

@@ -61,9 +61,9 @@
 #include <vector>
 
 #include "adjustment/adjustment_io.h"
+#include "adjustment/trajectory_adjuster.h"
 #include "tests/support/synthetic_survey.h"
 #include "tiepoints/tie_points.h"
-#include "adjustment/trajectory_adjuster.h"
 
 namespace zebrageo {
 namespace {

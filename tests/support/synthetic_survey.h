@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "survey/tie_tracks.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
+#include "survey/tie_tracks.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
