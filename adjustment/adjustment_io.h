@@ -26,9 +26,9 @@
 #include <string>
 #include <vector>
 
-#include "adjustment/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "survey/survey.h"
+#include "survey/tie_tracks.h"
 
 namespace zebrageo {
 

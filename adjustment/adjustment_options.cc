@@ -52,13 +52,13 @@ std::string AdjustmentOptions::Check() const {
       {"blunder_sigma_floor_m", blunder_sigma_floor_m},
       {"tie_sigma_px", tie_sigma_px},
       {"line_loss_scale", line_loss_scale},
-      {"boresight_sigma_deg", boresight_sigma_deg},
+      {"boresight_sigma_rad", boresight_sigma_rad},
       {"lever_arm_sigma_m", lever_arm_sigma_m},
-      {"vertical_slip_sigma_deg", vertical_slip_sigma_deg},
+      {"vertical_slip_sigma_rad", vertical_slip_sigma_rad},
       {"vehicle_motion_rate_hz", vehicle_motion_rate_hz},
       {"vehicle_motion_correlation_s", vehicle_motion_correlation_s},
       {"vehicle_motion_half_chord_s", vehicle_motion_half_chord_s},
-      {"vehicle_misalignment_sigma_deg", vehicle_misalignment_sigma_deg},
+      {"vehicle_misalignment_sigma_rad", vehicle_misalignment_sigma_rad},
       {"axle_offset_sigma_m", axle_offset_sigma_m},
       {"vehicle_motion_loss_scale", vehicle_motion_loss_scale},
   };
@@ -67,8 +67,8 @@ std::string AdjustmentOptions::Check() const {
       return Violation(p.name, p.value, "must be finite and > 0");
     }
   }
-  if (!(sideslip_sigma_deg >= 0.0) || !std::isfinite(sideslip_sigma_deg)) {
-    return Violation("sideslip_sigma_deg", sideslip_sigma_deg,
+  if (!(sideslip_sigma_rad >= 0.0) || !std::isfinite(sideslip_sigma_rad)) {
+    return Violation("sideslip_sigma_rad", sideslip_sigma_rad,
                      "must be finite and >= 0 (0 disables)");
   }
   if (!(vehicle_motion_min_speed_mps >= 0.0)) {

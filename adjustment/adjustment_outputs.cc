@@ -1,3 +1,5 @@
+// The trajectory adjustment's results from its final state
+// (adjustment_outputs.h).
 #include "adjustment/adjustment_outputs.h"
 
 #include <glog/logging.h>
@@ -261,6 +263,15 @@ void FillControlPoints(const OutputContext& context, State* state,
   }
 }
 
+// The error model of the final adjustment.
+void SummariseModel(const State& state, AdjustmentSummary* summary) {
+  summary->position_sigma_m = state.model.position_sigma_m;
+  summary->position_tau_s = state.model.position_tau_s;
+  summary->attitude_sigma_rad = state.model.attitude_sigma_rad;
+  summary->motion_sigma_rad = state.model.motion_sigma_rad;
+  summary->tie_sigma_px = state.model.tie_sigma_px;
+}
+
 }  // namespace
 
 Eigen::Vector3d ExposureOffsetAt(const State& state, double time) {
@@ -313,6 +324,47 @@ bool FillOutputs(const OutputContext& context, State* state,
   }
 
   return true;
+}
+
+Eigen::Vector2d CrabRmsDeg(const State& state) {
+  std::vector<double> lateral, vertical;
+  for (const VehicleMotionSample& sample : state.motion) {
+    const Eigen::Vector2d crab =
+        CrabAngleResidual(sample, state.correction, state.vehicle.data());
+    lateral.push_back(RadToDeg(crab.x()));
+    vertical.push_back(RadToDeg(crab.y()));
+  }
+  return Eigen::Vector2d(Rms(lateral), Rms(vertical));
+}
+
+void SummariseFinalState(const OutputContext& context, const State& state,
+                         const StateRms& before, const StateRms& after,
+                         const Eigen::Vector2d& crab_before_deg,
+                         AdjustmentSummary* summary) {
+  summary->rms.push_back({"control_image", "px", after.control_images,
+                          before.control_px, after.control_px});
+  summary->rms.push_back({"control_database", "m", after.control_points,
+                          before.control_m, after.control_m});
+  if (!state.ties.empty()) {
+    summary->rms.push_back(
+        {"tie_image", "px", after.tie_images, before.tie_px, after.tie_px});
+  }
+  if (!state.motion.empty()) {
+    const Eigen::Vector2d crab_after_deg = CrabRmsDeg(state);
+    summary->rms.push_back({"vehicle_lateral_slip", "deg",
+                            summary->num_vehicle_motion, crab_before_deg.x(),
+                            crab_after_deg.x()});
+    summary->rms.push_back({"vehicle_vertical_slip", "deg",
+                            summary->num_vehicle_motion, crab_before_deg.y(),
+                            crab_after_deg.y()});
+    summary->vehicle_yaw_misalignment_deg = RadToDeg(state.vehicle[0]);
+    summary->vehicle_axle_offset_m = state.vehicle[1];
+    summary->vehicle_pitch_misalignment_deg = RadToDeg(state.vehicle[2]);
+  }
+  SummariseModel(state, summary);
+  summary->rms.push_back({"trajectory_correction_horizontal", "m",
+                          context.input->trajectory->size(), 0.0,
+                          summary->rms_correction_horizontal_m});
 }
 
 }  // namespace adjustment_internal

@@ -44,6 +44,18 @@ Eigen::Vector3d ExposureOffsetAt(const State& state, double time);
 bool FillOutputs(const OutputContext& context, State* state,
                  AdjustmentResult* result);
 
+// RMS crab angles (lateral, vertical) the vehicle-motion constraint leaves,
+// degrees (the unit of adjustment.json's rms table).
+Eigen::Vector2d CrabRmsDeg(const State& state);
+
+// The summary's RMS of each observation type before (`before`,
+// `crab_before_deg`: the INS trajectory and the database points) and after
+// the adjustment, the vehicle block and the final error model.
+void SummariseFinalState(const OutputContext& context, const State& state,
+                         const StateRms& before, const StateRms& after,
+                         const Eigen::Vector2d& crab_before_deg,
+                         AdjustmentSummary* summary);
+
 }  // namespace adjustment_internal
 }  // namespace zebrageo
 

@@ -211,8 +211,7 @@ void AdjustmentProblem::AddRigPriors() {
   for (auto& r : state_->rig_corrections) {
     problem_->AddParameterBlock(r.data(), kRigCorrectionSize);
     Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();
-    S.diagonal().head<3>().setConstant(1.0 /
-                                       DegToRad(options_.boresight_sigma_deg));
+    S.diagonal().head<3>().setConstant(1.0 / options_.boresight_sigma_rad);
     S.diagonal().tail<3>().setConstant(1.0 / options_.lever_arm_sigma_m);
     problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S, {1.0}), nullptr,
                                r.data());
@@ -304,8 +303,7 @@ void AdjustmentProblem::AddVehicleMotion() {
   double* vehicle = state_->vehicle.data();
   problem_->AddParameterBlock(vehicle, kVehicleSize);
   ++num_pose_blocks_;
-  const double misalignment =
-      1.0 / DegToRad(options_.vehicle_misalignment_sigma_deg);
+  const double misalignment = 1.0 / options_.vehicle_misalignment_sigma_rad;
   const Eigen::Matrix3d S =
       Eigen::Vector3d(misalignment, 1.0 / options_.axle_offset_sigma_m,
                       misalignment)

@@ -208,5 +208,72 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
   return verdicts;
 }
 
+GaussMarkovFitOptions PositionFitOptions(const AdjustmentOptions& options) {
+  GaussMarkovFitOptions fit;
+  fit.min_sigma = options.min_position_sigma_m;
+  fit.max_sigma = options.max_position_sigma_m;
+  fit.default_tau_s = options.position_tau_s;
+  fit.min_samples_for_tau = options.min_crossings_for_tau;
+  return fit;
+}
+
+void RejectInconsistentCrossings(const Context& context,
+                                 const CrossingTable& crossings,
+                                 const std::vector<CrossingDiscrepancy>& d,
+                                 State* state) {
+  const std::vector<CrossingVerdict> verdicts =
+      adjustment_internal::SelectConsistentCrossings(
+          d, crossings.names, PositionFitOptions(context.options),
+          context.options.crossing_consistency_chi_square);
+  for (size_t c = 0; c < verdicts.size(); ++c) {
+    if (verdicts[c].consistent) continue;
+    context.Warn(verdicts[c].reason + ": not used as control");
+    for (ControlPoint& p : state->points) {
+      if (p.crossing == static_cast<int>(c)) {
+        p.status = ControlStatus::kRejected;
+        p.normalized_residual = std::sqrt(verdicts[c].chi_square);
+      }
+    }
+  }
+}
+
+void MarkCheckCrossings(const Context& context, const CrossingTable& crossings,
+                        State* state) {
+  const AdjustmentOptions& options = context.options;
+  const int num_crossings = static_cast<int>(crossings.names.size());
+  std::vector<char> usable(num_crossings, 0);
+  for (const ControlPoint& p : state->points) {
+    if (p.status == ControlStatus::kControl) usable[p.crossing] = 1;
+  }
+  std::vector<int> order;
+  for (int c = 0; c < num_crossings; ++c) {
+    if (usable[c]) order.push_back(c);
+  }
+  if (options.check_crossing_share <= 0.0 || order.empty()) return;
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return crossings.first_time[a] < crossings.first_time[b];
+  });
+  const int k = std::max(
+      2, static_cast<int>(std::lround(1.0 / options.check_crossing_share)));
+  std::vector<int> checks;
+  for (size_t i = k / 2; i < order.size(); i += k) checks.push_back(order[i]);
+  if (static_cast<int>(order.size() - checks.size()) <
+      options.min_control_crossings) {
+    if (!checks.empty()) {
+      context.Warn("only " + std::to_string(order.size()) +
+                   " crossings matched: none held out as check points, the "
+                   "accuracy reported is not independently checked");
+    }
+    return;
+  }
+  std::vector<char> is_check(num_crossings, 0);
+  for (int c : checks) is_check[c] = 1;
+  for (ControlPoint& p : state->points) {
+    if (p.status == ControlStatus::kControl && is_check[p.crossing]) {
+      p.status = ControlStatus::kCheck;
+    }
+  }
+}
+
 }  // namespace adjustment_internal
 }  // namespace zebrageo

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "adjustment/adjustment_context.h"
 #include "adjustment/adjustment_state.h"
 #include "adjustment/error_model.h"
 
@@ -62,6 +63,23 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
 std::vector<GaussMarkovFit> FitAxes(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<bool>& use, const GaussMarkovFitOptions& fit_options);
+
+// The Gauss-Markov fit of the position process from the options' bounds.
+GaussMarkovFitOptions PositionFitOptions(const AdjustmentOptions& options);
+
+// Crossings that disagree with the others and the error model
+// (SelectConsistentCrossings) are rejected whole, with a warning naming
+// each; their points' normalized_residual is the test's sqrt(chi-square).
+void RejectInconsistentCrossings(const Context& context,
+                                 const CrossingTable& crossings,
+                                 const std::vector<CrossingDiscrepancy>& d,
+                                 State* state);
+
+// Check crossings: every k-th consistent crossing in time order
+// (k = 1 / check_crossing_share), as long as min_control_crossings remain;
+// their control points become ControlStatus::kCheck.
+void MarkCheckCrossings(const Context& context, const CrossingTable& crossings,
+                        State* state);
 
 }  // namespace adjustment_internal
 }  // namespace zebrageo

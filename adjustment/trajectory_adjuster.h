@@ -46,7 +46,6 @@
 
 #include "adjustment/line_control.h"
 #include "adjustment/solver_options.h"
-#include "adjustment/tie_points.h"
 #include "adjustment/trajectory_correction.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
@@ -54,6 +53,7 @@
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
+#include "survey/tie_tracks.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
@@ -116,7 +116,7 @@ struct AdjustmentOptions {
   // is continuous) and the GNSS prior follows the jumps, so the correction
   // stays smooth; 0 disables the detection.
   double jump_threshold_m = 0.05;
-  double jump_threshold_deg = 0.05;
+  double jump_threshold_rad = DegToRad(0.05);
 
   // ---------------------------------------------------- control points
   // Each control vertex is observed as its exposure's stereo pair
@@ -182,12 +182,13 @@ struct AdjustmentOptions {
   // along its heading, so the direction of travel of the corrected
   // positions holds the heading where only they are controlled (between
   // and beyond crossings, along road lines), and their height the pitch.
-  // sideslip_sigma_deg, vertical_slip_sigma_deg: the spread of the angle
+  // sideslip_sigma_rad, vertical_slip_sigma_rad: the spread of the angle
   // between the velocity and the body's x axis (lateral, vertical) from the
   // body's oscillations, per constraint (they average out over a second or
-  // two); sideslip_sigma_deg = 0 disables both.
-  double sideslip_sigma_deg = 0.1;
-  double vertical_slip_sigma_deg = 0.35;
+  // two); sideslip_sigma_rad = 0 disables both. (The CLI's
+  // --sideslip-sigma is in degrees.)
+  double sideslip_sigma_rad = DegToRad(0.1);
+  double vertical_slip_sigma_rad = DegToRad(0.35);
   double vehicle_motion_rate_hz = 10.0;
   // The sideslip's departures are correlated over about this time (the
   // body rolling and yawing on its suspension, the driver's steering):
@@ -201,7 +202,7 @@ struct AdjustmentOptions {
   // Priors of the vehicle block: the INS's yaw and pitch misalignment to
   // the vehicle's axis, and its distance ahead of the axle that does not
   // slip.
-  double vehicle_misalignment_sigma_deg = 1.0;
+  double vehicle_misalignment_sigma_rad = DegToRad(1.0);
   double axle_offset_sigma_m = 3.0;
   // Cauchy loss on the constraint, in sigmas (a skid, a wrong sample).
   double vehicle_motion_loss_scale = 3.0;
@@ -210,7 +211,7 @@ struct AdjustmentOptions {
   // Estimate each camera's boresight rotation and lever arm (shared by all
   // exposures) with these priors around rig.yaml.
   bool self_calibrate_rig = false;
-  double boresight_sigma_deg = 0.2;
+  double boresight_sigma_rad = DegToRad(0.2);
   double lever_arm_sigma_m = 0.02;
 
   // ---------------------------------------------------- covariance

@@ -1,7 +1,7 @@
 // adjustment_bench: scaling of the trajectory adjustment with survey length.
 //
 //   adjustment_bench [--threads N] [--sizes 1000,5000,20000]
-//       Synthetic surveys (adjustment/synthetic_survey.h: 10 m/s, an
+//       Synthetic surveys (tests/support/synthetic_survey.h: 10 m/s, an
 //       exposure every 0.3 s, a crossing every 80 m, 2 m drift, --ties N
 //       ideal tie points per exposure) of each size; prints the adjustment
 //       time (2 threads by default, covariance off so the figure is the
@@ -61,9 +61,9 @@
 #include <vector>
 
 #include "adjustment/adjustment_io.h"
-#include "adjustment/synthetic_survey.h"
-#include "adjustment/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
+#include "tests/support/synthetic_survey.h"
+#include "tiepoints/tie_points.h"
 
 namespace zebrageo {
 namespace {

@@ -31,8 +31,8 @@
 #include <string>
 #include <vector>
 
-#include "adjustment/bal_adjuster.h"
-#include "adjustment/bal_problem.h"
+#include "adjustment/bal/bal_adjuster.h"
+#include "adjustment/bal/bal_problem.h"
 
 namespace zebrageo {
 namespace {

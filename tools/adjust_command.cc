@@ -10,11 +10,11 @@
 #include <set>
 
 #include "adjustment/adjustment_io.h"
-#include "adjustment/tie_points.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "survey/atomic_file.h"
 #include "survey/output_crs.h"
 #include "survey/results.h"
+#include "tiepoints/tie_points.h"
 #include "tools/commands.h"
 #include "tools/exit_codes.h"
 #include "tools/progress.h"
@@ -31,7 +31,7 @@ struct AdjustArguments {
   bool self_calibrate = false;
   double check_share = AdjustmentOptions().check_crossing_share;
   int threads = AdjustmentOptions().solver.num_threads;
-  double sideslip_sigma_deg = AdjustmentOptions().sideslip_sigma_deg;
+  double sideslip_sigma_deg = RadToDeg(AdjustmentOptions().sideslip_sigma_rad);
 };
 
 void RunAdjust(const AdjustArguments& args) {
@@ -39,7 +39,7 @@ void RunAdjust(const AdjustArguments& args) {
   options.check_crossing_share = args.check_share;
   options.self_calibrate_rig = args.self_calibrate;
   options.solver.num_threads = args.threads;
-  options.sideslip_sigma_deg = args.sideslip_sigma_deg;
+  options.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
   ResultsSession session(args.stage.results,

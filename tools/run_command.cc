@@ -27,7 +27,7 @@ struct RunArguments {
   int threads = 0;
   bool tie_points = true;
   bool lines = true;  // road lines as control beside the zebras (issue 9)
-  double sideslip_sigma_deg = AdjustmentOptions().sideslip_sigma_deg;
+  double sideslip_sigma_deg = RadToDeg(AdjustmentOptions().sideslip_sigma_rad);
   // Second registration pass with the adjusted trajectory.
   bool rematch = true;
 };
@@ -65,7 +65,7 @@ void Run(const RunArguments& args) {
   MatchOptions matching;
   AdjustmentOptions adjustment;
   if (args.threads > 0) adjustment.solver.num_threads = args.threads;
-  adjustment.sideslip_sigma_deg = args.sideslip_sigma_deg;
+  adjustment.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
   for (const std::string& problem :
        {reconstruction.Check(), matching.Check(), adjustment.Check()}) {
     if (!problem.empty()) throw UsageError(problem);

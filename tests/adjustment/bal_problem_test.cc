@@ -1,4 +1,4 @@
-#include "adjustment/bal_problem.h"
+#include "adjustment/bal/bal_problem.h"
 
 #include <ceres/numeric_diff_cost_function.h>
 #include <ceres/rotation.h>
@@ -8,8 +8,8 @@
 #include <cmath>
 #include <random>
 
-#include "adjustment/bal_adjuster.h"
-#include "adjustment/snavely_reprojection_error.h"
+#include "adjustment/bal/bal_adjuster.h"
+#include "adjustment/bal/snavely_reprojection_error.h"
 #include "survey/input_error.h"
 #include "tests/survey/test_util.h"
 

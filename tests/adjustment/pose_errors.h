@@ -7,8 +7,8 @@
 #include <cmath>
 #include <vector>
 
-#include "adjustment/synthetic_survey.h"
 #include "survey/results.h"
+#include "tests/support/synthetic_survey.h"
 
 namespace zebrageo {
 

@@ -8,9 +8,9 @@
 #include <set>
 
 #include "adjustment/adjustment_io.h"
-#include "adjustment/synthetic_survey.h"
 #include "survey/input_error.h"
 #include "tests/adjustment/pose_errors.h"
+#include "tests/support/synthetic_survey.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -252,7 +252,7 @@ TEST(TrajectoryAdjuster, VehicleMotionHoldsTheHeadingBetweenCrossings) {
   survey_options.heading_drift_deg = 0.15;
   const Fixture f = MakeFixture(survey_options);
   AdjustmentOptions without;
-  without.sideslip_sigma_deg = 0.0;
+  without.sideslip_sigma_rad = 0.0;
   const AdjustmentResult a = AdjustTrajectory(without, f.Input());
   const AdjustmentResult b = AdjustTrajectory(AdjustmentOptions(), f.Input());
   ASSERT_TRUE(a.summary.IsUsable()) << a.summary.message;

@@ -1,4 +1,4 @@
-#include "adjustment/bal_adjuster.h"
+#include "adjustment/bal/bal_adjuster.h"
 
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "adjustment/snavely_reprojection_error.h"
+#include "adjustment/bal/snavely_reprojection_error.h"
 
 namespace zebrageo {
 

@@ -1,12 +1,12 @@
 // Solves a BAL problem (bal_problem.h) with the project's solver core: the
 // Snavely residual (analytic Jacobians by default), every camera and point
 // free, cameras in the reduced camera system (points eliminated by Schur).
-#ifndef ZEBRAGEO_ADJUSTMENT_BAL_ADJUSTER_H_
-#define ZEBRAGEO_ADJUSTMENT_BAL_ADJUSTER_H_
+#ifndef ZEBRAGEO_ADJUSTMENT_BAL_BAL_ADJUSTER_H_
+#define ZEBRAGEO_ADJUSTMENT_BAL_BAL_ADJUSTER_H_
 
 #include <string>
 
-#include "adjustment/bal_problem.h"
+#include "adjustment/bal/bal_problem.h"
 #include "adjustment/solver_options.h"
 
 namespace zebrageo {
@@ -41,4 +41,4 @@ BalAdjusterSummary AdjustBalProblem(const BalAdjusterOptions& options,
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_ADJUSTMENT_BAL_ADJUSTER_H_
+#endif  // ZEBRAGEO_ADJUSTMENT_BAL_BAL_ADJUSTER_H_

@@ -13,8 +13,8 @@
 //   p = -P.xy / P.z         the camera looks down -z
 //   pixel = f (1 + k1 |p|^2 + k2 |p|^4) p
 // The cost of a problem is 1/2 sum |pixel - observed|^2, as Ceres reports it.
-#ifndef ZEBRAGEO_ADJUSTMENT_BAL_PROBLEM_H_
-#define ZEBRAGEO_ADJUSTMENT_BAL_PROBLEM_H_
+#ifndef ZEBRAGEO_ADJUSTMENT_BAL_BAL_PROBLEM_H_
+#define ZEBRAGEO_ADJUSTMENT_BAL_BAL_PROBLEM_H_
 
 #include <Eigen/Core>
 #include <array>
@@ -93,4 +93,4 @@ BalProblem ReadColmapModel(const std::string& folder);
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_ADJUSTMENT_BAL_PROBLEM_H_
+#endif  // ZEBRAGEO_ADJUSTMENT_BAL_BAL_PROBLEM_H_

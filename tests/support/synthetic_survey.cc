@@ -1,4 +1,4 @@
-#include "adjustment/synthetic_survey.h"
+#include "tests/support/synthetic_survey.h"
 
 #include <glog/logging.h>
 

@@ -1,4 +1,4 @@
-#include "adjustment/bal_problem.h"
+#include "adjustment/bal/bal_problem.h"
 
 #include <bzlib.h>
 #include <ceres/rotation.h>

@@ -7,8 +7,8 @@
 // analytic cost function with the same residual, twice as fast to evaluate,
 // used by the BAL solver. Their Jacobians are compared with numeric
 // differentiation in tests/adjustment/bal_problem_test.cc.
-#ifndef ZEBRAGEO_ADJUSTMENT_SNAVELY_REPROJECTION_ERROR_H_
-#define ZEBRAGEO_ADJUSTMENT_SNAVELY_REPROJECTION_ERROR_H_
+#ifndef ZEBRAGEO_ADJUSTMENT_BAL_SNAVELY_REPROJECTION_ERROR_H_
+#define ZEBRAGEO_ADJUSTMENT_BAL_SNAVELY_REPROJECTION_ERROR_H_
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/rotation.h>
@@ -136,4 +136,4 @@ class SnavelyReprojectionCost : public ceres::SizedCostFunction<2, 9, 3> {
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_ADJUSTMENT_SNAVELY_REPROJECTION_ERROR_H_
+#endif  // ZEBRAGEO_ADJUSTMENT_BAL_SNAVELY_REPROJECTION_ERROR_H_

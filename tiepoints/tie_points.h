@@ -6,36 +6,24 @@
 //
 // Frames: tracks are triangulated in the survey's ENU frame; observations
 // are distorted pixel coordinates (pixel (0,0) = centre of the top-left
-// pixel), as the vertex observations.
-#ifndef ZEBRAGEO_ADJUSTMENT_TIE_POINTS_H_
-#define ZEBRAGEO_ADJUSTMENT_TIE_POINTS_H_
+// pixel), as the vertex observations. Angles in radians.
+//
+// The tracks and the summary are plain data of survey/tie_tracks.h: the
+// adjustment receives them without including this library.
+#ifndef ZEBRAGEO_TIEPOINTS_TIE_POINTS_H_
+#define ZEBRAGEO_TIEPOINTS_TIE_POINTS_H_
 
-#include <Eigen/Core>
-#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "survey/exposures.h"
+#include "survey/math_util.h"
 #include "survey/rig.h"
+#include "survey/tie_tracks.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
-
-struct TieObservation {
-  int image = 0;  // index into ExposureTable::images
-  double time = 0.0;
-  int camera = 0;  // index into Rig::cameras
-  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
-  // The feature's pyramid scale (1.2^octave): a corner found on a coarser
-  // level is localised that many times less precisely.
-  double scale = 1.0;
-};
-
-struct TieTrack {
-  std::vector<TieObservation> observations;         // at most one per image
-  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();  // triangulated
-};
 
 struct TiePointOptions {
   // ORB features detected per image.
@@ -56,10 +44,10 @@ struct TiePointOptions {
   int exposure_window = 2;
   // Triangulated tracks are kept when every reprojection error is below
   // this (pixels), the point is 2 to max_range_m in front of each camera
-  // and the largest intersection angle exceeds min_triangulation_angle_deg.
+  // and the largest intersection angle exceeds min_triangulation_angle_rad.
   double max_reprojection_error_px = 1.5;
   double max_range_m = 40.0;
-  double min_triangulation_angle_deg = 2.0;
+  double min_triangulation_angle_rad = DegToRad(2.0);
   int min_track_length = 4;
   // Keep only tracks seen by both cameras of a stereo pair at least once.
   bool require_stereo = true;
@@ -67,21 +55,15 @@ struct TiePointOptions {
   // enough to keep the adjustment fast.
   int max_tracks_per_exposure = 25;
 
+  // "" when valid, else "field = value: constraint".
   std::string Check() const;
 };
 
-struct TiePointSummary {
-  int images_read = 0;
-  int images_missing = 0;
-  int matches = 0;
-  int tracks = 0;
-  int observations = 0;
-  double time_in_seconds = 0.0;
-};
-
 // Builds tie-point tracks from the survey's images. Images that cannot be
-// read are skipped (counted in the summary). `progress(done, total)` is
-// called after each exposure when set.
+// read are skipped (counted in `summary`, which may be null).
+// `progress(done, total)` is called after each exposure when set. Throws
+// std::invalid_argument ("TiePointOptions: field = value: constraint") when
+// options.Check() fails.
 std::vector<TieTrack> BuildTieTracks(
     const TiePointOptions& options, const std::string& survey_folder,
     const Rig& rig, const Trajectory& trajectory,
@@ -90,4 +72,4 @@ std::vector<TieTrack> BuildTieTracks(
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_ADJUSTMENT_TIE_POINTS_H_
+#endif  // ZEBRAGEO_TIEPOINTS_TIE_POINTS_H_

@@ -8,19 +8,19 @@
 // body frame (+ noise), and matched to its database vertex.
 //
 // Frames as everywhere: ENU working frame, body FRD, camera OpenCV.
-#ifndef ZEBRAGEO_ADJUSTMENT_SYNTHETIC_SURVEY_H_
-#define ZEBRAGEO_ADJUSTMENT_SYNTHETIC_SURVEY_H_
+#ifndef ZEBRAGEO_TESTS_SUPPORT_SYNTHETIC_SURVEY_H_
+#define ZEBRAGEO_TESTS_SUPPORT_SYNTHETIC_SURVEY_H_
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "adjustment/tie_points.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
+#include "survey/tie_tracks.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
@@ -115,4 +115,4 @@ void WriteSyntheticSurvey(const SyntheticSurvey& survey,
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_ADJUSTMENT_SYNTHETIC_SURVEY_H_
+#endif  // ZEBRAGEO_TESTS_SUPPORT_SYNTHETIC_SURVEY_H_

@@ -1,0 +1,34 @@
+// Internal to the trajectory adjustment: the state's starting point before
+// the solves: the zero correction with the prior's centre at each knot
+// (the INS jumps), the vehicle-motion constraints and their sigma, and the
+// GNSS/INS error model estimated from the control (error_model.h).
+#ifndef ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_SETUP_H_
+#define ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_SETUP_H_
+
+#include <vector>
+
+#include "adjustment/adjustment_context.h"
+#include "adjustment/adjustment_state.h"
+#include "adjustment/control_selection.h"
+#include "adjustment/error_model.h"
+
+namespace zebrageo {
+namespace adjustment_internal {
+
+// The zero correction over the trajectory, the prior's centre at each knot
+// (the jumps taken out before it) and the vehicle-motion constraints
+// (state->motion, state->model.motion_sigma_rad).
+void InitialiseCorrection(const Context& context, State* state);
+
+// The error model the adjustment starts from: the position process fitted
+// to the consistent crossings' discrepancies, the attitude from the
+// trajectory's own claimed sd, the exposures' jitter where the positions
+// show one.
+ErrorModel InitialErrorModel(const Context& context,
+                             const std::vector<CrossingDiscrepancy>& d,
+                             const State& state);
+
+}  // namespace adjustment_internal
+}  // namespace zebrageo
+
+#endif  // ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_SETUP_H_

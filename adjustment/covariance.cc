@@ -1,0 +1,68 @@
+// The posterior covariance of the corrected positions (covariance.h).
+#include "adjustment/covariance.h"
+
+#include <ceres/covariance.h>
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+namespace zebrageo {
+namespace adjustment_internal {
+
+std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
+                                              State* state,
+                                              AdjustmentProblem* problem) {
+  const AdjustmentOptions& options = context.options;
+  const Trajectory& trajectory = *context.input.trajectory;
+  std::vector<Eigen::Matrix3d> sample_covariance;
+  if (problem == nullptr || !options.compute_covariance ||
+      state->correction.num_knots() > options.max_knots_for_covariance) {
+    return sample_covariance;
+  }
+  ceres::Covariance::Options covariance_options;
+  covariance_options.num_threads = options.solver.num_threads;
+  covariance_options.algorithm_type = ceres::SPARSE_QR;
+  ceres::Covariance covariance(covariance_options);
+  auto& knots = state->correction.knots();
+  const int n = static_cast<int>(knots.size());
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i; j < std::min(n, i + 4); ++j) {
+      pairs.emplace_back(knots[i].data(), knots[j].data());
+    }
+  }
+  if (!covariance.Compute(pairs, problem->problem())) {
+    context.Warn(
+        "the posterior covariance could not be computed (rank deficient): "
+        "trajectory_corrected.csv keeps the input sd_*");
+    return sample_covariance;
+  }
+  const double sigma0 = context.summary->sigma0;
+  const double scale = std::max(1.0, sigma0 * sigma0);
+  sample_covariance.reserve(trajectory.size());
+  for (const TrajectorySample& sample : trajectory.samples()) {
+    int first = 0;
+    double w[4];
+    state->correction.Basis(sample.time, &first, w);
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        const int i = std::min(first + a, first + b);
+        const int j = std::max(first + a, first + b);
+        Eigen::Matrix<double, 6, 6, Eigen::RowMajor> block;
+        covariance.GetCovarianceBlock(knots[i].data(), knots[j].data(),
+                                      block.data());
+        Eigen::Matrix3d position = block.block<3, 3>(3, 3);
+        if (first + a > first + b) position.transposeInPlace();
+        C += w[a] * w[b] * position;
+      }
+    }
+    sample_covariance.push_back(scale * C);
+  }
+  context.summary->covariance_computed = true;
+  return sample_covariance;
+}
+
+}  // namespace adjustment_internal
+}  // namespace zebrageo

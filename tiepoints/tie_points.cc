@@ -1,0 +1,457 @@
+#include "tiepoints/tie_points.h"
+
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <numeric>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "survey/image_io.h"
+#include "survey/math_util.h"
+
+namespace zebrageo {
+namespace {
+
+constexpr float kOrbScaleFactor = 1.2f;
+
+struct ImageFeatures {
+  bool valid = false;
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  std::vector<Eigen::Vector2d> normalized;  // undistorted x/z, y/z
+  std::vector<char> has_normalized;
+  Eigen::Isometry3d T_enu_cam = Eigen::Isometry3d::Identity();
+};
+
+// Union-find over (image, keypoint) nodes.
+class DisjointSets {
+ public:
+  int Add() {
+    parent_.push_back(static_cast<int>(parent_.size()));
+    return parent_.back();
+  }
+  int Find(int x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void Union(int a, int b) { parent_[Find(a)] = Find(b); }
+
+ private:
+  std::vector<int> parent_;
+};
+
+// Epipolar distance (pixels in image b) of a correspondence between images
+// a and b with known poses.
+double EpipolarDistancePx(const ImageFeatures& a, const ImageFeatures& b,
+                          const Eigen::Vector2d& xa, const Eigen::Vector2d& xb,
+                          double focal_b) {
+  const Eigen::Isometry3d T_b_a = b.T_enu_cam.inverse() * a.T_enu_cam;
+  const Eigen::Vector3d t = T_b_a.translation();
+  Eigen::Matrix3d tx;
+  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  const Eigen::Matrix3d E = tx * T_b_a.linear();
+  const Eigen::Vector3d line = E * xa.homogeneous();
+  const double norm = line.head<2>().norm();
+  if (norm <= 0.0) return HUGE_VAL;
+  return std::abs(line.dot(xb.homogeneous())) / norm * focal_b;
+}
+
+// A matched component that passed every test, and the exposures it ties.
+struct Candidate {
+  TieTrack track;
+  std::vector<int> exposures;
+};
+
+// Why matched components did not become tracks (VLOG(1)): a diagnosis of
+// a scene whose ties are few.
+struct Rejections {
+  int components = 0, short_track = 0, same_image = 0, narrow_angle = 0,
+      reprojection = 0, one_exposure = 0, no_stereo = 0;
+};
+
+// The features of every image and the matches between them, as a
+// union-find over (image, keypoint) nodes; its connected components are the
+// candidate tracks.
+class FeatureGraph {
+ public:
+  FeatureGraph(const TiePointOptions& options, const std::string& folder,
+               const Rig& rig, const Trajectory& trajectory,
+               const ExposureTable& exposures, TiePointSummary* summary)
+      : options_(options),
+        folder_(folder),
+        rig_(rig),
+        trajectory_(trajectory),
+        exposures_(exposures),
+        summary_(summary),
+        features_(exposures.images.size()),
+        node_offset_(exposures.images.size(), 0),
+        orb_(cv::ORB::create(options.max_features_per_image, kOrbScaleFactor,
+                             options.orb_levels)),
+        matcher_(cv::NORM_HAMMING) {
+    for (int e = 0; e < static_cast<int>(exposures.exposures.size()); ++e) {
+      exposure_index_[exposures.exposures[e].exposure_id] = e;
+    }
+  }
+
+  // Each exposure's images matched within its stereo pairs and with the
+  // same camera of the exposure_window exposures before it.
+  void MatchExposures(const std::function<void(int, int)>& progress);
+
+  // The components that make a track, in the order of their roots.
+  std::vector<Candidate> Candidates(Rejections* rejected);
+
+ private:
+  void Load(int image_index);
+  void RefineSubpixel(const cv::Mat& grey, ImageFeatures* f) const;
+  void Match(int a, int b);
+  // Midpoint triangulation of the nodes' rays; false when not finite.
+  bool Triangulate(const std::vector<int>& nodes, Eigen::Vector3d* X,
+                   double* max_angle) const;
+  // False (the reason counted in `rejected`) when the component is no
+  // track.
+  bool MakeCandidate(const std::vector<int>& nodes, Rejections* rejected,
+                     Candidate* candidate);
+  bool HasStereo(const TieTrack& track);
+
+  const TiePointOptions& options_;
+  const std::string& folder_;
+  const Rig& rig_;
+  const Trajectory& trajectory_;
+  const ExposureTable& exposures_;
+  TiePointSummary* summary_;
+  std::vector<ImageFeatures> features_;
+  std::vector<int> node_offset_;
+  DisjointSets sets_;
+  std::vector<std::pair<int, int>> node_key_;  // node -> (image, keypoint)
+  std::map<int64_t, int> exposure_index_;
+  cv::Ptr<cv::ORB> orb_;
+  cv::BFMatcher matcher_;
+};
+
+void FeatureGraph::Load(int image_index) {
+  ImageFeatures& f = features_[image_index];
+  const ExposureImage& image = exposures_.images[image_index];
+  const std::string path =
+      (std::filesystem::path(folder_) / image.image).string();
+  Pose pose;
+  if (!trajectory_.InterpolatePose(image.time, &pose)) return;
+  cv::Mat grey;
+  try {
+    const cv::Mat f32 = ReadGrayImage(path, image.image);
+    f32.convertTo(grey, CV_8U);
+  } catch (const std::exception&) {
+    ++summary_->images_missing;
+    return;
+  }
+  ++summary_->images_read;
+  orb_->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
+  // ORB reports a keypoint found on pyramid level l at x_l * s; with
+  // pixel centres at integers (cv::resize) it is at (x_l + 0.5) s - 0.5.
+  for (cv::KeyPoint& kp : f.keypoints) {
+    const double scale = std::pow(kOrbScaleFactor, kp.octave);
+    kp.pt.x += static_cast<float>(0.5 * (scale - 1.0));
+    kp.pt.y += static_cast<float>(0.5 * (scale - 1.0));
+  }
+  if (options_.refine_subpixel) RefineSubpixel(grey, &f);
+  const Camera& camera = rig_.cameras[image.camera].camera;
+  f.normalized.resize(f.keypoints.size());
+  f.has_normalized.assign(f.keypoints.size(), 0);
+  for (size_t k = 0; k < f.keypoints.size(); ++k) {
+    const Eigen::Vector2d uv(f.keypoints[k].pt.x, f.keypoints[k].pt.y);
+    f.has_normalized[k] = camera.UnprojectToNormalized(uv, &f.normalized[k]);
+  }
+  f.T_enu_cam = pose.T_enu_body() * rig_.cameras[image.camera].T_body_cam;
+  f.valid = !f.keypoints.empty();
+  node_offset_[image_index] = static_cast<int>(node_key_.size());
+  for (size_t k = 0; k < f.keypoints.size(); ++k) {
+    sets_.Add();
+    node_key_.emplace_back(image_index, static_cast<int>(k));
+  }
+}
+
+void FeatureGraph::RefineSubpixel(const cv::Mat& grey, ImageFeatures* f) const {
+  if (f->keypoints.empty()) return;
+  std::vector<cv::Point2f> corners;
+  for (const cv::KeyPoint& kp : f->keypoints) corners.push_back(kp.pt);
+  cv::cornerSubPix(
+      grey, corners, cv::Size(2, 2), cv::Size(-1, -1),
+      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10,
+                       0.01));
+  for (size_t k = 0; k < corners.size(); ++k) {
+    // Keep the detector's position when the refinement wanders off.
+    const cv::Point2f d = corners[k] - f->keypoints[k].pt;
+    if (d.dot(d) < 1.0) f->keypoints[k].pt = corners[k];
+  }
+}
+
+void FeatureGraph::Match(int a, int b) {
+  const ImageFeatures& fa = features_[a];
+  const ImageFeatures& fb = features_[b];
+  if (!fa.valid || !fb.valid) return;
+  std::vector<std::vector<cv::DMatch>> knn;
+  matcher_.knnMatch(fa.descriptors, fb.descriptors, knn, 2);
+  const double focal = rig_.cameras[exposures_.images[b].camera].camera.fx();
+  for (const auto& m : knn) {
+    if (m.size() < 2 ||
+        m[0].distance > options_.max_descriptor_ratio * m[1].distance) {
+      continue;
+    }
+    const int ka = m[0].queryIdx, kb = m[0].trainIdx;
+    if (!fa.has_normalized[ka] || !fb.has_normalized[kb]) continue;
+    if (EpipolarDistancePx(fa, fb, fa.normalized[ka], fb.normalized[kb],
+                           focal) > options_.max_epipolar_distance_px) {
+      continue;
+    }
+    sets_.Union(node_offset_[a] + ka, node_offset_[b] + kb);
+    ++summary_->matches;
+  }
+}
+
+void FeatureGraph::MatchExposures(
+    const std::function<void(int, int)>& progress) {
+  const int num_exposures = static_cast<int>(exposures_.exposures.size());
+  const int window = options_.exposure_window;
+  for (int e = 0; e < num_exposures; ++e) {
+    const Exposure& exposure = exposures_.exposures[e];
+    for (int image : exposure.image_of_camera) {
+      if (image >= 0) Load(image);
+    }
+    for (const auto& pair : rig_.stereo_pairs) {
+      const int a = exposure.image_of_camera[pair[0]];
+      const int b = exposure.image_of_camera[pair[1]];
+      if (a >= 0 && b >= 0) Match(a, b);
+    }
+    for (int back = 1; back <= window && e - back >= 0; ++back) {
+      const Exposure& previous = exposures_.exposures[e - back];
+      for (size_t c = 0; c < rig_.cameras.size(); ++c) {
+        const int a = previous.image_of_camera[c];
+        const int b = exposure.image_of_camera[c];
+        if (a >= 0 && b >= 0) Match(a, b);
+      }
+    }
+    // Descriptors of exposures out of the window are no longer needed.
+    if (e - window >= 0) {
+      for (int image : exposures_.exposures[e - window].image_of_camera) {
+        if (image >= 0) features_[image].descriptors.release();
+      }
+    }
+    if (progress) progress(e + 1, num_exposures);
+  }
+}
+
+bool FeatureGraph::Triangulate(const std::vector<int>& nodes,
+                               Eigen::Vector3d* X, double* max_angle) const {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> directions;
+  for (int node : nodes) {
+    const auto [image, k] = node_key_[node];
+    const ImageFeatures& f = features_[image];
+    const Eigen::Vector3d d =
+        (f.T_enu_cam.linear() * f.normalized[k].homogeneous()).normalized();
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+    A += P;
+    b += P * f.T_enu_cam.translation();
+    directions.push_back(d);
+  }
+  *X = A.ldlt().solve(b);
+  if (!X->allFinite()) return false;
+  *max_angle = 0.0;
+  for (size_t i = 0; i < directions.size(); ++i) {
+    for (size_t j = i + 1; j < directions.size(); ++j) {
+      *max_angle = std::max(
+          *max_angle,
+          std::acos(std::clamp(directions[i].dot(directions[j]), -1.0, 1.0)));
+    }
+  }
+  return true;
+}
+
+// A stereo observation fixes the depth: a temporal mismatch on a repeated
+// pattern (windows, bands) that slides along the epipolar line cannot agree
+// with it.
+bool FeatureGraph::HasStereo(const TieTrack& track) {
+  std::map<int, int> cameras_in_exposure;
+  bool stereo = false;
+  for (const TieObservation& o : track.observations) {
+    const int e = exposure_index_[exposures_.images[o.image].exposure_id];
+    stereo |= ++cameras_in_exposure[e] >= 2;
+  }
+  return stereo;
+}
+
+bool FeatureGraph::MakeCandidate(const std::vector<int>& nodes,
+                                 Rejections* rejected, Candidate* candidate) {
+  if (static_cast<int>(nodes.size()) < options_.min_track_length) {
+    ++rejected->short_track;
+    return false;
+  }
+  std::vector<int> images;
+  for (int node : nodes) images.push_back(node_key_[node].first);
+  std::sort(images.begin(), images.end());
+  if (std::adjacent_find(images.begin(), images.end()) != images.end()) {
+    ++rejected->same_image;
+    return false;
+  }
+  Eigen::Vector3d X;
+  double max_angle = 0.0;
+  if (!Triangulate(nodes, &X, &max_angle)) return false;
+  if (max_angle < options_.min_triangulation_angle_rad) {
+    ++rejected->narrow_angle;
+    return false;
+  }
+  for (int node : nodes) {
+    const auto [image, k] = node_key_[node];
+    const ImageFeatures& f = features_[image];
+    const ExposureImage& info = exposures_.images[image];
+    const Eigen::Vector3d p_cam = f.T_enu_cam.inverse() * X;
+    Eigen::Vector2d uv;
+    const Eigen::Vector2d observed(f.keypoints[k].pt.x, f.keypoints[k].pt.y);
+    if (p_cam.z() < 2.0 || p_cam.norm() > options_.max_range_m ||
+        !rig_.cameras[info.camera].camera.Project(p_cam, &uv) ||
+        (uv - observed).norm() > options_.max_reprojection_error_px) {
+      ++rejected->reprojection;
+      return false;
+    }
+    candidate->track.observations.push_back(
+        {image, info.time, info.camera, observed,
+         std::pow(kOrbScaleFactor, f.keypoints[k].octave)});
+    candidate->exposures.push_back(exposure_index_[info.exposure_id]);
+  }
+  candidate->track.p_enu = X;
+  std::vector<int>& tied = candidate->exposures;
+  std::sort(tied.begin(), tied.end());
+  tied.erase(std::unique(tied.begin(), tied.end()), tied.end());
+  if (tied.size() < 2) {  // ties exposures together
+    ++rejected->one_exposure;
+    return false;
+  }
+  if (options_.require_stereo && !HasStereo(candidate->track)) {
+    ++rejected->no_stereo;
+    return false;
+  }
+  return true;
+}
+
+std::vector<Candidate> FeatureGraph::Candidates(Rejections* rejected) {
+  // Tracks: connected components, at most one keypoint per image.
+  std::map<int, std::vector<int>> components;
+  for (int node = 0; node < static_cast<int>(node_key_.size()); ++node) {
+    components[sets_.Find(node)].push_back(node);
+  }
+  std::vector<Candidate> candidates;
+  for (const auto& [root, nodes] : components) {
+    if (nodes.size() < 2) continue;
+    ++rejected->components;
+    Candidate candidate;
+    if (MakeCandidate(nodes, rejected, &candidate)) {
+      candidates.push_back(std::move(candidate));
+    }
+  }
+  return candidates;
+}
+
+// The longest tracks first, until every exposure has enough.
+std::vector<TieTrack> SelectTracks(const TiePointOptions& options,
+                                   int num_exposures,
+                                   std::vector<Candidate> candidates,
+                                   TiePointSummary* summary) {
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) {
+              return a.track.observations.size() > b.track.observations.size();
+            });
+  std::vector<int> kept_per_exposure(num_exposures, 0);
+  std::vector<TieTrack> tracks;
+  for (Candidate& c : candidates) {
+    bool useful = false;
+    for (int e : c.exposures) {
+      useful |= kept_per_exposure[e] < options.max_tracks_per_exposure;
+    }
+    if (!useful) continue;
+    for (int e : c.exposures) ++kept_per_exposure[e];
+    summary->observations += static_cast<int>(c.track.observations.size());
+    tracks.push_back(std::move(c.track));
+  }
+  summary->tracks = static_cast<int>(tracks.size());
+  return tracks;
+}
+
+}  // namespace
+
+std::string TiePointOptions::Check() const {
+  std::ostringstream message;
+  if (max_features_per_image < 10) {
+    message << "max_features_per_image = " << max_features_per_image
+            << ": must be >= 10";
+  } else if (!(max_descriptor_ratio > 0.0 && max_descriptor_ratio <= 1.0)) {
+    message << "max_descriptor_ratio = " << max_descriptor_ratio
+            << ": must be in (0, 1]";
+  } else if (!(max_epipolar_distance_px > 0.0)) {
+    message << "max_epipolar_distance_px = " << max_epipolar_distance_px
+            << ": must be > 0";
+  } else if (exposure_window < 1) {
+    message << "exposure_window = " << exposure_window << ": must be >= 1";
+  } else if (!(max_reprojection_error_px > 0.0)) {
+    message << "max_reprojection_error_px = " << max_reprojection_error_px
+            << ": must be > 0";
+  } else if (!(max_range_m > 2.0)) {
+    message << "max_range_m = " << max_range_m << ": must be > 2";
+  } else if (!(min_triangulation_angle_rad >= 0.0)) {
+    message << "min_triangulation_angle_rad = " << min_triangulation_angle_rad
+            << ": must be >= 0";
+  } else if (min_track_length < 2) {
+    message << "min_track_length = " << min_track_length << ": must be >= 2";
+  } else if (max_tracks_per_exposure < 1) {
+    message << "max_tracks_per_exposure = " << max_tracks_per_exposure
+            << ": must be >= 1";
+  }
+  return message.str();
+}
+
+std::vector<TieTrack> BuildTieTracks(
+    const TiePointOptions& options, const std::string& survey_folder,
+    const Rig& rig, const Trajectory& trajectory,
+    const ExposureTable& exposures, TiePointSummary* summary,
+    const std::function<void(int, int)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string error = options.Check();
+  if (!error.empty()) {
+    throw std::invalid_argument("TiePointOptions: " + error);
+  }
+  TiePointSummary local_summary;
+  if (summary == nullptr) summary = &local_summary;
+  *summary = TiePointSummary();
+
+  FeatureGraph graph(options, survey_folder, rig, trajectory, exposures,
+                     summary);
+  graph.MatchExposures(progress);
+  Rejections rejected;
+  std::vector<Candidate> candidates = graph.Candidates(&rejected);
+  VLOG(1) << "tie points: " << rejected.components
+          << " matched components; too short " << rejected.short_track
+          << ", two keypoints in one image " << rejected.same_image
+          << ", intersection angle " << rejected.narrow_angle
+          << ", reprojection or range " << rejected.reprojection
+          << ", one exposure " << rejected.one_exposure << ", no stereo "
+          << rejected.no_stereo << "; " << candidates.size() << " candidates";
+  std::vector<TieTrack> tracks =
+      SelectTracks(options, static_cast<int>(exposures.exposures.size()),
+                   std::move(candidates), summary);
+  summary->time_in_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  LOG(INFO) << "tie points: " << summary->tracks << " tracks, "
+            << summary->observations << " observations from "
+            << summary->images_read << " images in " << summary->time_in_seconds
+            << " s";
+  return tracks;
+}
+
+}  // namespace zebrageo
