@@ -172,6 +172,81 @@ bool RoadLinesControl(const json& road_lines, double t0, double t1) {
   return overlapping > 0 && 2 * controlled > overlapping;
 }
 
+// Warnings: the survey's, the stages' (those the match and adjust stages
+// recorded in their files too, so that every warning they logged is here,
+// resumed stages included), and what the figures show. Marks the
+// uncontrolled stretches the road lines control.
+std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
+                                        const ReportOptions& options,
+                                        const ReportData& data, int matched,
+                                        json* report) {
+  const Survey& survey = *inputs.survey;
+  std::vector<std::string> warnings = survey.warnings;
+  warnings.insert(warnings.end(), inputs.warnings.begin(),
+                  inputs.warnings.end());
+  for (const json* stage_file : {&data.match_evidence, &data.adjustment}) {
+    if (!stage_file->is_object()) continue;
+    for (const json& w : stage_file->value("warnings", json::array())) {
+      if (w.is_string()) warnings.push_back(w.get<std::string>());
+    }
+  }
+  for (const std::string& file : data.missing_files) {
+    warnings.push_back("no " + file + " in the results folder");
+  }
+  if (survey.roadmarks.bands.empty()) {
+    warnings.push_back("the road-mark database (" + survey.manifest.roadmarks +
+                       ") holds no zebra band: nothing can control the "
+                       "trajectory");
+  }
+  if (data.decisions.empty() || matched == 0) {
+    warnings.push_back(
+        "no zebra crossing was matched: the trajectory is not "
+        "controlled anywhere");
+  }
+  for (json& s : (*report)["uncontrolled_stretches"]) {
+    const bool lines = RoadLinesControl(report->value("road_lines", json()),
+                                        s["start_time_s"].get<double>(),
+                                        s["end_time_s"].get<double>());
+    s["road_lines_control_cross_track_and_height"] = lines;
+    std::ostringstream text;
+    text.precision(0);
+    text << std::fixed << "no control over " << s["length_m"].get<double>()
+         << " m of trajectory (t = " << s["start_time_s"].get<double>()
+         << " to " << s["end_time_s"].get<double>() << " s) by zebra crossings"
+         << (lines ? "; road lines control cross-track and height there, "
+                     "along-track is not controlled"
+                   : "");
+    warnings.push_back(text.str());
+  }
+  if (data.adjustment.is_object() && data.adjustment.contains("sigma0") &&
+      data.adjustment["sigma0"].is_number() &&
+      data.adjustment["sigma0"].get<double>() > options.max_sigma0) {
+    warnings.push_back("high sigma0 (" + data.adjustment["sigma0"].dump() +
+                       "): observations fit worse than their stated weights");
+  }
+  if (report->contains("road_lines")) {
+    for (const json& line :
+         (*report)["road_lines"].value("rejected_lines", json::array())) {
+      std::ostringstream text;
+      text.precision(2);
+      text << std::fixed << "database: road line "
+           << line.value("db_line", std::string()) << " ("
+           << line.value("type", std::string()) << ") lies "
+           << std::abs(line.value("offset_m", 0.0))
+           << " m across from where the other lines put it: repainted or "
+              "stale, not used as control";
+      warnings.push_back(text.str());
+    }
+  }
+  for (const json& fault : (*report)["database_faults"]) {
+    if (fault.contains("description")) {
+      warnings.push_back("database: " +
+                         fault["description"].get<std::string>());
+    }
+  }
+  return warnings;
+}
+
 json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
                    const ReportData& data) {
   const Survey& survey = *inputs.survey;
@@ -270,73 +345,8 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
   if (inputs.peak_memory_mb > 0.0)
     report["peak_memory_mb"] = inputs.peak_memory_mb;
 
-  // Warnings: the survey's, the stages' (those the match and adjust stages
-  // recorded in their files too, so that every warning they logged is
-  // here, resumed stages included), and what the figures show.
-  std::vector<std::string> warnings = survey.warnings;
-  warnings.insert(warnings.end(), inputs.warnings.begin(),
-                  inputs.warnings.end());
-  for (const json* stage_file : {&data.match_evidence, &data.adjustment}) {
-    if (!stage_file->is_object()) continue;
-    for (const json& w : stage_file->value("warnings", json::array())) {
-      if (w.is_string()) warnings.push_back(w.get<std::string>());
-    }
-  }
-  for (const std::string& file : data.missing_files) {
-    warnings.push_back("no " + file + " in the results folder");
-  }
-  if (survey.roadmarks.bands.empty()) {
-    warnings.push_back("the road-mark database (" + survey.manifest.roadmarks +
-                       ") holds no zebra band: nothing can control the "
-                       "trajectory");
-  }
-  if (data.decisions.empty() || matched == 0) {
-    warnings.push_back(
-        "no zebra crossing was matched: the trajectory is not "
-        "controlled anywhere");
-  }
-  for (json& s : report["uncontrolled_stretches"]) {
-    const bool lines = RoadLinesControl(report.value("road_lines", json()),
-                                        s["start_time_s"].get<double>(),
-                                        s["end_time_s"].get<double>());
-    s["road_lines_control_cross_track_and_height"] = lines;
-    std::ostringstream text;
-    text.precision(0);
-    text << std::fixed << "no control over " << s["length_m"].get<double>()
-         << " m of trajectory (t = " << s["start_time_s"].get<double>()
-         << " to " << s["end_time_s"].get<double>() << " s) by zebra crossings"
-         << (lines ? "; road lines control cross-track and height there, "
-                     "along-track is not controlled"
-                   : "");
-    warnings.push_back(text.str());
-  }
-  if (data.adjustment.is_object() && data.adjustment.contains("sigma0") &&
-      data.adjustment["sigma0"].is_number() &&
-      data.adjustment["sigma0"].get<double>() > options.max_sigma0) {
-    warnings.push_back("high sigma0 (" + data.adjustment["sigma0"].dump() +
-                       "): observations fit worse than their stated weights");
-  }
-  if (report.contains("road_lines")) {
-    for (const json& line :
-         report["road_lines"].value("rejected_lines", json::array())) {
-      std::ostringstream text;
-      text.precision(2);
-      text << std::fixed << "database: road line "
-           << line.value("db_line", std::string()) << " ("
-           << line.value("type", std::string()) << ") lies "
-           << std::abs(line.value("offset_m", 0.0))
-           << " m across from where the other lines put it: repainted or "
-              "stale, not used as control";
-      warnings.push_back(text.str());
-    }
-  }
-  for (const json& fault : report["database_faults"]) {
-    if (fault.contains("description")) {
-      warnings.push_back("database: " +
-                         fault["description"].get<std::string>());
-    }
-  }
-  report["warnings"] = WithoutRepeats(warnings);
+  report["warnings"] =
+      WithoutRepeats(ReportWarnings(inputs, options, data, matched, &report));
   return report;
 }
 
