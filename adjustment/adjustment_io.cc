@@ -29,132 +29,87 @@ std::string RequiredStageFile(const std::string& results_folder,
   return path;
 }
 
-nlohmann::json Vector3Json(const Eigen::Vector3d& v) {
-  return nlohmann::json::array({v.x(), v.y(), v.z()});
-}
-
-nlohmann::json SummaryJson(const AdjustmentData& data,
-                           const AdjustmentOptions& options,
-                           const AdjustmentResult& result,
-                           const TiePointSummary* ties) {
+AdjustmentRecord RecordOf(const AdjustmentData& data,
+                          const AdjustmentOptions& options,
+                          const AdjustmentResult& result,
+                          const TiePointSummary* ties) {
   const AdjustmentSummary& s = result.summary;
-  nlohmann::json j;
-  j["usable"] = s.usable;
-  j["message"] = s.message;
-  j["sigma0"] = s.sigma0;
-  j["iterations"] = s.iterations;
-  j["solves"] = s.solves;
-  j["time_s"] = s.time_in_seconds;
-  j["counts"] = {
-      {"exposures", s.num_exposures},
-      {"trajectory_samples", data.trajectory.size()},
-      {"knots", s.num_knots},
-      {"control_vertices", s.num_control_points},
-      {"check_vertices", s.num_check_points},
-      {"rejected_vertices", s.num_rejected_points},
-      {"control_crossings", s.num_control_crossings},
-      {"check_crossings", s.num_check_crossings},
-      {"tie_tracks", s.num_tie_tracks},
-      {"residuals", s.num_residuals},
-      {"reconstructed_vertices", data.vertices.size()},
-      {"matches", data.matches.size()},
-  };
-  nlohmann::json rms = nlohmann::json::object();
-  for (const ObservationRms& r : s.rms) {
-    rms[r.type] = {{"unit", r.unit},
-                   {"count", r.count},
-                   {"before", r.before},
-                   {"after", r.after}};
+  AdjustmentRecord r;
+  r.usable = s.usable;
+  r.message = s.message;
+  r.sigma0 = s.sigma0;
+  r.iterations = s.iterations;
+  r.solves = s.solves;
+  r.time_s = s.time_in_seconds;
+  r.counts = {s.num_exposures,
+              data.trajectory.size(),
+              s.num_knots,
+              s.num_control_points,
+              s.num_check_points,
+              s.num_rejected_points,
+              s.num_control_crossings,
+              s.num_check_crossings,
+              s.num_tie_tracks,
+              s.num_residuals,
+              static_cast<int64_t>(data.vertices.size()),
+              static_cast<int64_t>(data.matches.size())};
+  for (const ObservationRms& rms : s.rms) {
+    r.rms[rms.type] = {rms.unit, rms.count, rms.before, rms.after};
   }
-  j["rms"] = rms;
-  j["control_rmse_m"] = {{"horizontal", s.control_rmse_horizontal_m},
-                         {"vertical", s.control_rmse_vertical_m}};
-  // Check points are held out: their RMSE is the honest accuracy figure. It
-  // includes the database's own error (its sigma and per-crossing offset).
-  // No check point evaluated: null, so no one reads a perfect 0.
-  const bool checked = s.num_check_points_evaluated > 0;
-  j["check_rmse_m"] = {
-      {"horizontal", checked ? nlohmann::json(s.check_rmse_horizontal_m)
-                             : nlohmann::json(nullptr)},
-      {"vertical", checked ? nlohmann::json(s.check_rmse_vertical_m)
-                           : nlohmann::json(nullptr)},
-      {"vertices", s.num_check_points},
-      {"evaluated_vertices", s.num_check_points_evaluated},
-      {"expected_from_database",
-       {{"horizontal", checked
-                           ? nlohmann::json(s.check_database_rms_horizontal_m)
-                           : nlohmann::json(nullptr)},
-        {"vertical", checked ? nlohmann::json(s.check_database_rms_vertical_m)
-                             : nlohmann::json(nullptr)}}},
-      {"implied_trajectory",
-       {{"horizontal",
-         checked ? nlohmann::json(s.check_implied_trajectory_horizontal_m)
-                 : nlohmann::json(nullptr)},
-        {"vertical", checked
-                         ? nlohmann::json(s.check_implied_trajectory_vertical_m)
-                         : nlohmann::json(nullptr)}}},
-      {"note",
-       "check residual = trajectory error + database error; "
-       "implied_trajectory = sqrt(max(0, rmse^2 - expected_from_database^2)), "
-       "for the adjustment made without the check crossings"},
-      {"crossings", s.num_check_crossings},
-      {"held_out_then_control", s.check_points_in_final}};
-  j["correction_m"] = {{"max_horizontal", s.max_correction_horizontal_m},
-                       {"max_vertical", s.max_correction_vertical_m},
-                       {"rms_horizontal", s.rms_correction_horizontal_m}};
-  j["posterior_sd_m"] = {
-      {"computed", s.covariance_computed},
-      {"median_horizontal", s.median_posterior_sd_horizontal_m},
-      {"median_vertical", s.median_posterior_sd_vertical_m}};
-  nlohmann::json rejected = nlohmann::json::array();
+  r.control_rmse_horizontal_m = s.control_rmse_horizontal_m;
+  r.control_rmse_vertical_m = s.control_rmse_vertical_m;
+  r.check = {s.check_rmse_horizontal_m,
+             s.check_rmse_vertical_m,
+             s.num_check_points,
+             s.num_check_points_evaluated,
+             s.check_database_rms_horizontal_m,
+             s.check_database_rms_vertical_m,
+             s.check_implied_trajectory_horizontal_m,
+             s.check_implied_trajectory_vertical_m,
+             s.num_check_crossings,
+             s.check_points_in_final};
+  r.max_correction_horizontal_m = s.max_correction_horizontal_m;
+  r.max_correction_vertical_m = s.max_correction_vertical_m;
+  r.rms_correction_horizontal_m = s.rms_correction_horizontal_m;
+  r.posterior_sd_computed = s.covariance_computed;
+  r.median_posterior_sd_horizontal_m = s.median_posterior_sd_horizontal_m;
+  r.median_posterior_sd_vertical_m = s.median_posterior_sd_vertical_m;
   for (const ControlPointResult& p : result.control_points) {
     if (p.status != ControlStatus::kRejected) continue;
-    rejected.push_back(
-        {{"crossing_id", p.crossing_id},
-         {"band", p.band},
-         {"vertex", p.db_vertex},
-         {"normalized_residual", p.normalized_residual},
-         {"d_enu_m", Vector3Json(p.image_enu - p.database_enu)}});
+    r.rejected.push_back({p.crossing_id, p.band, p.db_vertex,
+                          p.normalized_residual,
+                          p.image_enu - p.database_enu});
   }
-  j["rejected"] = rejected;
-  nlohmann::json rig = nlohmann::json::array();
   for (size_t c = 0; c < result.T_body_cam.size(); ++c) {
     const Eigen::Isometry3d& T = result.T_body_cam[c];
     const Eigen::AngleAxisd change(
         data.rig.cameras[c].T_body_cam.linear().transpose() * T.linear());
-    rig.push_back({{"camera", data.rig.cameras[c].camera.name()},
-                   {"lever_arm_m", Vector3Json(T.translation())},
-                   {"boresight_change_deg", change.angle() * 180.0 / M_PI}});
+    r.rig.push_back({data.rig.cameras[c].camera.name(), T.translation(),
+                     change.angle() * 180.0 / M_PI});
   }
-  j["rig"] = rig;
-  j["model"] = {
-      {"knot_spacing_s", options.knot_spacing_s},
-      {"position_model_estimated", options.estimate_position_model},
-      // Along-track, cross-track, up.
-      {"position_sigma_m", Vector3Json(s.position_sigma_m)},
-      {"position_tau_s", Vector3Json(s.position_tau_s)},
-      {"attitude_sigma_deg", Vector3Json(RadToDeg(1.0) * s.attitude_sigma_rad)},
-      {"vehicle_motion_sigma_deg",
-       {RadToDeg(s.motion_sigma_rad.x()), RadToDeg(s.motion_sigma_rad.y())}},
-      {"tie_sigma_px", s.tie_sigma_px},
-      {"vertex_sigma_px", options.vertex_sigma_px},
-      {"crossing_offset_sigma_m", options.crossing_offset_sigma_m},
-      {"check_crossing_share", options.check_crossing_share},
-      {"blunder_threshold", options.blunder_threshold},
-      {"self_calibrate_rig", options.self_calibrate_rig},
-  };
+  AdjustmentRecord::Model& m = r.model;
+  m.knot_spacing_s = options.knot_spacing_s;
+  m.position_model_estimated = options.estimate_position_model;
+  // Along-track, cross-track, up.
+  m.position_sigma_m = s.position_sigma_m;
+  m.position_tau_s = s.position_tau_s;
+  m.attitude_sigma_deg = RadToDeg(1.0) * s.attitude_sigma_rad;
+  m.vehicle_motion_sigma_deg = Eigen::Vector2d(
+      RadToDeg(s.motion_sigma_rad.x()), RadToDeg(s.motion_sigma_rad.y()));
+  m.tie_sigma_px = s.tie_sigma_px;
+  m.vertex_sigma_px = options.vertex_sigma_px;
+  m.crossing_offset_sigma_m = options.crossing_offset_sigma_m;
+  m.check_crossing_share = options.check_crossing_share;
+  m.blunder_threshold = options.blunder_threshold;
+  m.self_calibrate_rig = options.self_calibrate_rig;
   if (ties != nullptr) {
-    j["tie_points"] = {{"images_read", ties->images_read},
-                       {"images_missing", ties->images_missing},
-                       {"matches", ties->matches},
-                       {"tracks", ties->tracks},
-                       {"observations", ties->observations},
-                       {"time_s", ties->time_in_seconds}};
+    r.tie_points = AdjustmentRecord::TiePoints{
+        ties->images_read, ties->images_missing, ties->matches,
+        ties->tracks,      ties->observations,   ties->time_in_seconds};
   }
-  std::vector<std::string> warnings = data.warnings;
-  warnings.insert(warnings.end(), s.warnings.begin(), s.warnings.end());
-  j["warnings"] = warnings;
-  return j;
+  r.warnings = data.warnings;
+  r.warnings.insert(r.warnings.end(), s.warnings.begin(), s.warnings.end());
+  return r;
 }
 
 void WriteColmapExport(const AdjustmentData& data,
@@ -303,6 +258,34 @@ AdjustmentInput AdjustmentData::Input() const {
   return input;
 }
 
+namespace {
+
+// What LoadAdjustmentData and AdjustmentDataOf share once the survey's
+// files are read: the missing images, and the stage files.
+void CompleteAdjustmentData(const std::string& results_folder,
+                            AdjustmentData* data) {
+  for (const ExposureImage& image : data->exposures.images) {
+    std::error_code error;
+    if (!fs::is_regular_file(fs::path(data->survey_folder) / image.image,
+                             error)) {
+      ++data->missing_images;
+    }
+  }
+  if (data->missing_images > 0 &&
+      data->missing_images < static_cast<int>(data->exposures.images.size())) {
+    data->warnings.push_back(std::to_string(data->missing_images) + " of " +
+                             std::to_string(data->exposures.images.size()) +
+                             " images are missing: no tie points in them");
+  }
+  data->vertices = ReadReconstructedBands(
+      RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct"),
+      kReconstructedBandsFile);
+  data->matches = ReadMatches(
+      RequiredStageFile(results_folder, kMatchesFile, "match"), kMatchesFile);
+}
+
+}  // namespace
+
 AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
                                   const std::string& results_folder,
                                   const SurveyPathOptions& paths) {
@@ -327,53 +310,47 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
                            " at time " + FormatDouble(image.time) +
                            " is outside the trajectory's span");
     }
-    std::error_code error;
-    if (!fs::is_regular_file(path_of(image.image), error))
-      ++data.missing_images;
-  }
-  if (data.missing_images > 0 &&
-      data.missing_images < static_cast<int>(data.exposures.images.size())) {
-    data.warnings.push_back(std::to_string(data.missing_images) + " of " +
-                            std::to_string(data.exposures.images.size()) +
-                            " images are missing: no tie points in them");
   }
   data.roadmarks = ReadSurveyRoadmarks(survey_folder, data.manifest,
                                        data.trajectory.samples());
-  data.vertices = ReadReconstructedBands(
-      RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct"),
-      kReconstructedBandsFile);
-  data.matches = ReadMatches(
-      RequiredStageFile(results_folder, kMatchesFile, "match"), kMatchesFile);
+  CompleteAdjustmentData(results_folder, &data);
   return data;
 }
 
-void WriteGcpResidualsWithStatus(const std::vector<ControlPointResult>& points,
-                                 const std::string& path) {
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    CsvWriter csv(&out);
-    csv.Comment(
-        "d* = adjusted (control) or image-only (check, rejected) minus "
-        "database, metres ENU; status: control | check | rejected (blunder, "
-        "removed from the adjustment)");
-    csv.Header({"crossing_id", "band", "vertex", "role", "de", "dn", "du",
-                "d3d", "rms_px", "n_images", "status", "normalized_residual"});
-    for (const ControlPointResult& p : points) {
-      const Eigen::Vector3d d = p.adjusted_enu - p.database_enu;
-      csv.Add(p.crossing_id)
-          .Add(p.band)
-          .Add(p.db_vertex)
-          .Add(p.status == ControlStatus::kCheck ? "check" : "control")
-          .AddFixed(d.x(), 4)
-          .AddFixed(d.y(), 4)
-          .AddFixed(d.z(), 4)
-          .AddFixed(d.norm(), 4)
-          .AddFixed(p.rms_px, 3)
-          .Add(p.n_images)
-          .Add(ControlStatusName(p.status))
-          .AddFixed(p.normalized_residual, 2);
-      csv.EndRow();
-    }
-  });
+AdjustmentData AdjustmentDataOf(const Survey& survey,
+                                const std::string& results_folder) {
+  AdjustmentData data;
+  data.survey_folder = survey.folder;
+  data.manifest = survey.manifest;
+  data.rig = survey.rig;
+  data.frame = survey.frame;
+  data.trajectory = survey.trajectory;
+  data.exposures = survey.exposures;
+  data.roadmarks = survey.roadmarks;
+  CompleteAdjustmentData(results_folder, &data);
+  return data;
+}
+
+std::vector<GcpResidual> GcpResidualsOf(
+    const std::vector<ControlPointResult>& points) {
+  std::vector<GcpResidual> residuals;
+  for (const ControlPointResult& p : points) {
+    GcpResidual r;
+    r.crossing_id = p.crossing_id;
+    r.band = p.band;
+    r.vertex = p.db_vertex;
+    r.role = p.status == ControlStatus::kCheck ? GcpRole::kCheck
+                                               : GcpRole::kControl;
+    r.d_enu = p.adjusted_enu - p.database_enu;
+    r.rms_px = p.rms_px;
+    r.n_images = p.n_images;
+    r.status = p.status == ControlStatus::kRejected ? GcpStatus::kRejected
+               : p.status == ControlStatus::kCheck  ? GcpStatus::kCheck
+                                                    : GcpStatus::kControl;
+    r.normalized_residual = p.normalized_residual;
+    residuals.push_back(r);
+  }
+  return residuals;
 }
 
 void WriteAdjustmentResults(const AdjustmentData& data,
@@ -386,13 +363,12 @@ void WriteAdjustmentResults(const AdjustmentData& data,
     return (fs::path(results_folder) / name).string();
   };
   WriteColmapExport(data, result, out(kColmapFolder));
-  WriteGcpResidualsWithStatus(result.control_points, out(kGcpResidualsFile));
+  WriteGcpResiduals(GcpResidualsOf(result.control_points),
+                    out(kGcpResidualsFile));
   WriteAdjustedBands(result.bands, out(kBandsGeoJsonFile));
-  const nlohmann::json summary =
-      SummaryJson(data, options, result, tie_summary);
-  WriteFileAtomically(out(kAdjustmentJsonFile), [&](std::ostream& stream) {
-    stream << summary.dump(2) << "\n";
-  });
+  const AdjustmentRecord record = RecordOf(data, options, result, tie_summary);
+  WriteAdjustmentRecord(record, out(kAdjustmentJsonFile));
+  const nlohmann::json summary = AdjustmentJson(record);
   nlohmann::json report;
   report["survey"] = data.manifest.name;
   report["stage"] = "adjust";
@@ -405,9 +381,7 @@ void WriteAdjustmentResults(const AdjustmentData& data,
   report["timings_s"] = {{"adjust", result.summary.time_in_seconds}};
   report["adjustment"] = summary;
   report["warnings"] = summary["warnings"];
-  WriteFileAtomically(out(kReportJsonFile), [&](std::ostream& stream) {
-    stream << report.dump(2) << "\n";
-  });
+  WriteReportJson(report, out(kReportJsonFile), 2);
   // The trajectory and the poses last: their presence means the stage
   // finished.
   WriteTrajectorySamples(result.corrected_samples,

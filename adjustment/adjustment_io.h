@@ -27,12 +27,12 @@
 #include <vector>
 
 #include "adjustment/trajectory_adjuster.h"
+#include "survey/results_adjustment.h"
 #include "survey/survey.h"
 #include "survey/tie_tracks.h"
 
 namespace zebrageo {
 
-inline constexpr char kAdjustmentJsonFile[] = "adjustment.json";
 inline constexpr char kColmapFolder[] = "colmap";
 
 struct AdjustmentData {
@@ -59,6 +59,10 @@ struct AdjustmentData {
 AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
                                   const std::string& results_folder,
                                   const SurveyPathOptions& paths = {});
+// The same from a survey already loaded (LoadSurvey reads its files as
+// LoadAdjustmentData does): only the stage files are read.
+AdjustmentData AdjustmentDataOf(const Survey& survey,
+                                const std::string& results_folder);
 
 // Writes every output listed above into `results_folder` (created if
 // needed). `tie_summary` may be null (no tie points). Throws
@@ -85,9 +89,9 @@ int RemoveRejectedMatches(const AdjustmentData& data,
                           const AdjustmentResult& result,
                           const std::string& results_folder);
 
-// Writes the gcp_residuals.csv rows of `points` to `path`.
-void WriteGcpResidualsWithStatus(const std::vector<ControlPointResult>& points,
-                                 const std::string& path);
+// The gcp_residuals.csv rows of `points` (survey/results.h writes them).
+std::vector<GcpResidual> GcpResidualsOf(
+    const std::vector<ControlPointResult>& points);
 
 }  // namespace zebrageo
 

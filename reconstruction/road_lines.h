@@ -45,6 +45,7 @@
 #include <vector>
 
 #include "reconstruction/road_rectification.h"
+#include "survey/results_lines.h"
 #include "survey/rig.h"
 #include "survey/survey.h"
 
@@ -158,8 +159,8 @@ bool RunCentre(const cv::Mat& image, const cv::Mat& binary, int y, int x,
 
 // --- A stereo pair -----------------------------------------------------------
 
-enum class RoadLineType { kLaneSolid, kLaneDashed, kStopLine };
-const char* RoadLineTypeName(RoadLineType type);  // lane_solid, ...
+// RoadLineType and RoadLineTypeName: survey/results_lines.h (the contract
+// of reconstructed_lines.csv).
 
 struct RoadLine3d {
   RoadLineType type = RoadLineType::kLaneSolid;
@@ -206,29 +207,8 @@ class StereoLineExtractor {
 
 // --- A survey ----------------------------------------------------------------
 
-// reconstructed_lines.csv: one row per vertex of a line seen in one pair.
-struct ReconstructedLinePoint {
-  int64_t exposure_id = 0;
-  int pair = 0;
-  int64_t line_id = 0;  // unique within the file
-  RoadLineType type = RoadLineType::kLaneSolid;
-  int point = 0;  // 0.. along the line
-  Eigen::Vector3d p_body = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d covariance_body = Eigen::Matrix3d::Zero();
-  Eigen::Vector2d uv_left = Eigen::Vector2d::Zero();
-  Eigen::Vector2d uv_right = Eigen::Vector2d::Zero();
-};
-
-inline constexpr char kReconstructedLinesFile[] = "reconstructed_lines.csv";
-
-void WriteReconstructedLines(const std::vector<ReconstructedLinePoint>& points,
-                             const std::vector<std::string>& comments,
-                             const std::string& path);
-
-// Throws InputError naming the file and line (missing column, bad number,
-// unknown type, negative variance).
-std::vector<ReconstructedLinePoint> ReadReconstructedLines(
-    const std::string& path, const std::string& display_name);
+// ReconstructedLinePoint, kReconstructedLinesFile and the reader and writer
+// of reconstructed_lines.csv: survey/results_lines.h.
 
 struct RoadLineSummary {
   int pairs = 0;

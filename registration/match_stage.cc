@@ -16,6 +16,7 @@
 #include "registration/paint_probe.h"
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
+#include "survey/results_adjustment.h"
 
 namespace zebrageo {
 namespace {
@@ -430,28 +431,25 @@ std::string RematchOptions::Check() const {
 
 namespace {
 
-// The adjustment's summary (adjustment/adjustment_io.h writes it): whether
-// trajectory_corrected.csv carries posterior sd.
-constexpr char kAdjustmentSummaryFile[] = "adjustment.json";
-
-// "" when the adjustment can gate the second pass, else why not.
+// "" when the adjustment (its adjustment.json, survey/results_adjustment.h)
+// can gate the second pass, else why not.
 std::string AdjustmentUnfitForRematch(const std::string& results_folder,
                                       int min_control_crossings) {
-  std::ifstream in(fs::path(results_folder) / kAdjustmentSummaryFile);
-  if (!in) return std::string(kAdjustmentSummaryFile) + " is missing";
-  const json j = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) {
-    return std::string(kAdjustmentSummaryFile) + " is not readable JSON";
+  const fs::path path = fs::path(results_folder) / kAdjustmentJsonFile;
+  if (!fs::exists(path)) {
+    return std::string(kAdjustmentJsonFile) + " is missing";
   }
-  const json sd = j.value("posterior_sd_m", json::object());
-  if (!sd.is_object() || !sd.value("computed", false)) {
+  AdjustmentRecord record;
+  try {
+    record = ReadAdjustmentRecord(path.string(), kAdjustmentJsonFile);
+  } catch (const InputError&) {
+    return std::string(kAdjustmentJsonFile) + " is not readable JSON";
+  }
+  if (!record.posterior_sd_computed) {
     return "the adjustment has no posterior covariance to gate it";
   }
-  const json counts = j.value("counts", json::object());
-  const int crossings = counts.is_object()
-                            ? counts.value("control_crossings", 0) +
-                                  counts.value("check_crossings", 0)
-                            : 0;
+  const int crossings =
+      record.counts.control_crossings + record.counts.check_crossings;
   if (crossings < min_control_crossings) {
     return "the adjustment has " + std::to_string(crossings) +
            " control crossings (" + std::to_string(min_control_crossings) +

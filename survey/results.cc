@@ -114,16 +114,6 @@ const char* RoleName(GcpRole role) {
   return role == GcpRole::kControl ? "control" : "check";
 }
 
-std::string ReadWholeFile(const std::string& path,
-                          const std::string& display_name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(display_name, 0, "cannot read " + path);
-  return text.str();
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -422,23 +412,43 @@ std::vector<CameraPose> ReadCameraPoses(const std::string& path,
 // ---------------------------------------------------------------------------
 // gcp_residuals.csv
 
+const char* GcpStatusName(GcpStatus status) {
+  switch (status) {
+    case GcpStatus::kControl:
+      return "control";
+    case GcpStatus::kCheck:
+      return "check";
+    case GcpStatus::kRejected:
+      return "rejected";
+  }
+  return "control";
+}
+
 void WriteGcpResiduals(const std::vector<GcpResidual>& residuals,
                        const std::string& path) {
   AtomicFile file(path);
   CsvWriter csv(&file.stream());
-  csv.Comment("d* = adjusted minus database, metres, ENU");
-  csv.Header(GcpColumns());
+  csv.Comment(
+      "d* = adjusted (control) or image-only (check, rejected) minus "
+      "database, metres ENU; status: control | check | rejected (blunder, "
+      "removed from the adjustment)");
+  std::vector<std::string> columns = GcpColumns();
+  columns.push_back("status");
+  columns.push_back("normalized_residual");
+  csv.Header(columns);
   for (const GcpResidual& r : residuals) {
     csv.Add(CheckedField(r.crossing_id, "crossing_id"))
         .Add(r.band)
         .Add(r.vertex)
         .Add(RoleName(r.role))
-        .Add(r.d_enu.x())
-        .Add(r.d_enu.y())
-        .Add(r.d_enu.z())
-        .Add(r.d_enu.norm())
-        .Add(r.rms_px)
-        .Add(r.n_images);
+        .AddFixed(r.d_enu.x(), 4)
+        .AddFixed(r.d_enu.y(), 4)
+        .AddFixed(r.d_enu.z(), 4)
+        .AddFixed(r.d_enu.norm(), 4)
+        .AddFixed(r.rms_px, 3)
+        .Add(r.n_images)
+        .Add(GcpStatusName(r.status))
+        .AddFixed(r.normalized_residual, 2);
     csv.EndRow();
   }
   file.Commit();
@@ -467,114 +477,23 @@ std::vector<GcpResidual> ReadGcpResiduals(const std::string& path,
     NonNegative(csv, row, "d3d");  // derived from de,dn,du; checked only
     r.rms_px = NonNegative(csv, row, "rms_px");
     r.n_images = IntInRange(csv, row, "n_images", 0, 1000000000);
+    r.status =
+        r.role == GcpRole::kCheck ? GcpStatus::kCheck : GcpStatus::kControl;
+    if (csv.HasColumn("status")) {
+      const std::string& status = csv.GetString(row, "status");
+      if (status == "rejected") {
+        r.status = GcpStatus::kRejected;
+      } else if (status != GcpStatusName(r.status)) {
+        csv.Fail(row, "column 'status': '" + status + "' is not " +
+                          GcpStatusName(r.status) + " or rejected");
+      }
+    }
+    if (csv.HasColumn("normalized_residual")) {
+      r.normalized_residual = NonNegative(csv, row, "normalized_residual");
+    }
     residuals.push_back(std::move(r));
   }
   return residuals;
-}
-
-// ---------------------------------------------------------------------------
-// bands.geojson
-
-void WriteAdjustedBands(const std::vector<AdjustedBand>& bands,
-                        const std::string& path) {
-  using geojson_internal::JsonString;
-  using geojson_internal::PositionText;
-  // One feature per line, like roadmarks.geojson.
-  std::string body = "{\"type\": \"FeatureCollection\", \"features\": [\n";
-  for (size_t i = 0; i < bands.size(); ++i) {
-    const AdjustedBand& band = bands[i];
-    std::string ring;
-    for (int k = 0; k <= 4; ++k) {
-      ring += (k > 0 ? ", " : "") + PositionText(band.corners[k % 4]);
-    }
-    body += std::string(i > 0 ? ",\n" : "") +
-            "{\"type\": \"Feature\", \"geometry\": {\"type\": \"Polygon\", "
-            "\"coordinates\": [[" +
-            ring + "]]}, \"properties\": {\"crossing_id\": " +
-            (band.crossing_id ? JsonString(*band.crossing_id) : "null") +
-            ", \"band\": " + (band.band ? std::to_string(*band.band) : "null") +
-            ", \"band_id\": " + std::to_string(band.band_id) +
-            ", \"exposure_id\": " + std::to_string(band.exposure_id) + "}}";
-  }
-  body += "\n]}\n";
-  AtomicFile file(path);
-  file.stream() << body;
-  file.Commit();
-}
-
-std::vector<AdjustedBand> ReadAdjustedBands(const std::string& path,
-                                            const std::string& display_name) {
-  const std::string text = ReadWholeFile(path, display_name);
-  const json root = geojson_internal::ParseJson(text, display_name);
-  if (!root.is_object() || !root.contains("type") ||
-      root["type"] != "FeatureCollection" || !root.contains("features") ||
-      !root["features"].is_array()) {
-    throw InputError(display_name, 1, "not a GeoJSON FeatureCollection");
-  }
-  const std::vector<int> lines = geojson_internal::FeatureLines(text);
-  const json& features = root["features"];
-  std::vector<AdjustedBand> bands;
-  for (size_t i = 0; i < features.size(); ++i) {
-    auto fail = [&](const std::string& problem) {
-      throw InputError(display_name, i < lines.size() ? lines[i] : 0,
-                       "feature " + std::to_string(i + 1) + ": " + problem);
-    };
-    const json& feature = features[i];
-    if (!feature.is_object() || !feature.contains("geometry") ||
-        !feature["geometry"].is_object() ||
-        !feature["geometry"].contains("type") ||
-        feature["geometry"]["type"] != "Polygon" ||
-        !feature["geometry"].contains("coordinates")) {
-      fail("expected a Polygon feature");
-    }
-    const json& rings = feature["geometry"]["coordinates"];
-    if (!rings.is_array() || rings.size() != 1 || !rings[0].is_array() ||
-        rings[0].size() != 5) {
-      fail("expected one ring of 5 positions");
-    }
-    AdjustedBand band;
-    Geodetic last;
-    for (int k = 0; k < 5; ++k) {
-      const std::string problem = geojson_internal::ReadPosition(
-          rings[0][k], k < 4 ? &band.corners[k] : &last);
-      if (!problem.empty())
-        fail("position " + std::to_string(k) + " " + problem);
-    }
-    if (last.lat_deg != band.corners[0].lat_deg ||
-        last.lon_deg != band.corners[0].lon_deg ||
-        last.h_m != band.corners[0].h_m) {
-      fail("ring is not closed");
-    }
-    if (!feature.contains("properties") || !feature["properties"].is_object()) {
-      fail("no properties");
-    }
-    const json& properties = feature["properties"];
-    for (const char* key : {"crossing_id", "band", "band_id", "exposure_id"}) {
-      if (!properties.contains(key)) {
-        fail(std::string("missing property '") + key + "'");
-      }
-    }
-    const json& crossing_id = properties["crossing_id"];
-    if (crossing_id.is_string()) {
-      band.crossing_id = crossing_id.get<std::string>();
-    } else if (!crossing_id.is_null()) {
-      fail("property 'crossing_id' must be a string or null");
-    }
-    const json& band_number = properties["band"];
-    if (band_number.is_number_integer()) {
-      band.band = band_number.get<int>();
-    } else if (!band_number.is_null()) {
-      fail("property 'band' must be an integer or null");
-    }
-    if (!properties["band_id"].is_number_integer() ||
-        !properties["exposure_id"].is_number_integer()) {
-      fail("properties 'band_id' and 'exposure_id' must be integers");
-    }
-    band.band_id = properties["band_id"].get<int64_t>();
-    band.exposure_id = properties["exposure_id"].get<int64_t>();
-    bands.push_back(std::move(band));
-  }
-  return bands;
 }
 
 }  // namespace zebrageo

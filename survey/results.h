@@ -107,8 +107,13 @@ void WriteCameraPoses(const std::vector<CameraPose>& poses,
 std::vector<CameraPose> ReadCameraPoses(const std::string& path,
                                         const std::string& display_name);
 
-// gcp_residuals.csv: adjusted minus database, metres, ENU.
+// gcp_residuals.csv: adjusted (control) or image-only (check, rejected)
+// minus database, metres, ENU; written with 0.1 mm, 0.001 px and 0.01
+// (normalized residual) resolution.
 enum class GcpRole { kControl, kCheck };
+// control | check | rejected (a blunder, removed from the adjustment).
+enum class GcpStatus { kControl, kCheck, kRejected };
+const char* GcpStatusName(GcpStatus status);
 struct GcpResidual {
   std::string crossing_id;
   int band = 0;
@@ -117,6 +122,9 @@ struct GcpResidual {
   Eigen::Vector3d d_enu = Eigen::Vector3d::Zero();
   double rms_px = 0.0;
   int n_images = 0;
+  // Files of older versions have no status column: the role's then.
+  GcpStatus status = GcpStatus::kControl;
+  double normalized_residual = 0.0;  // residual / its sd (blunder test)
 };
 void WriteGcpResiduals(const std::vector<GcpResidual>& residuals,
                        const std::string& path);

@@ -46,7 +46,7 @@ CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
 void AddAllowOutsidePathsFlag(CLI::App* subcommand, bool* allow);
 // How a stage command loads its survey.
 SurveyLoadOptions LoadOptionsOf(const StageArguments& args);
-// --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_deg).
+// --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_rad, in degrees here).
 void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg);
 // A runner for a stage that is not built yet: it validates the survey (so
 // the user learns whether it is readable), then throws NotImplementedError.

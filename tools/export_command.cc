@@ -8,10 +8,10 @@
 #include <string>
 
 #include "geodata/gcp_export.h"
+#include "pipeline/exit_codes.h"
 #include "survey/crs.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 
 namespace zebrageo {
 namespace {

@@ -12,11 +12,11 @@
 #include "geodata/calibration_import.h"
 #include "geodata/gps_time.h"
 #include "geodata/trajectory_import.h"
+#include "pipeline/exit_codes.h"
 #include "survey/crs.h"
 #include "survey/input_error.h"
 #include "survey/rig.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 
 namespace zebrageo {
 namespace {

@@ -8,12 +8,12 @@
 #include <iostream>
 #include <memory>
 
+#include "pipeline/exit_codes.h"
+#include "pipeline/results_session.h"
 #include "registration/match_stage.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 #include "tools/progress.h"
-#include "tools/results_session.h"
 
 namespace zebrageo {
 

@@ -57,4 +57,33 @@ void ProgressBar::Finish() {
   LOG(INFO) << stage_ << ": done in " << ElapsedSeconds() << " s";
 }
 
+ProgressListener ProgressBars() {
+  struct Bars {
+    std::mutex mutex;
+    std::map<int, std::unique_ptr<ProgressBar>> of_step;
+  };
+  auto bars = std::make_shared<Bars>();
+  return [bars](const ProgressEvent& event) {
+    ProgressBar* bar = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(bars->mutex);
+      if (event.kind == ProgressEvent::Kind::kStarted) {
+        bars->of_step[event.id] = std::make_unique<ProgressBar>(event.step);
+        return;
+      }
+      const auto it = bars->of_step.find(event.id);
+      if (it == bars->of_step.end()) return;
+      if (event.kind == ProgressEvent::Kind::kFinished) {
+        it->second->Finish();
+        bars->of_step.erase(it);
+        return;
+      }
+      bar = it->second.get();
+    }
+    // Outside the lock: the bar has its own; the step cannot finish while
+    // its own callback runs.
+    bar->Update(event.done, event.total);
+  };
+}
+
 }  // namespace zebrageo

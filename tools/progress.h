@@ -4,8 +4,12 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <string>
+
+#include "pipeline/progress.h"
 
 namespace zebrageo {
 
@@ -31,6 +35,10 @@ class ProgressBar {
   int last_logged_decile_ = -1;
   std::mutex mutex_;
 };
+
+// The pipeline's progress events (pipeline/progress.h) drawn as bars: one
+// ProgressBar per step, from kStarted to kFinished. Thread-safe.
+ProgressListener ProgressBars();
 
 }  // namespace zebrageo
 

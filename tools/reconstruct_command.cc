@@ -2,21 +2,17 @@
 // pair in 3D (body frame), written to RESULTS/reconstructed_bands.csv.
 #include <glog/logging.h>
 
-#include <filesystem>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "pipeline/exit_codes.h"
+#include "pipeline/results_session.h"
+#include "pipeline/stages.h"
 #include "reconstruction/reconstruction.h"
-#include "survey/input_error.h"
-#include "survey/results.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 #include "tools/progress.h"
-#include "tools/results_session.h"
-#include "tools/stages.h"
 
 namespace zebrageo {
 namespace {
@@ -68,77 +64,6 @@ void RunReconstruct(const ReconstructArguments& args) {
 }
 
 }  // namespace
-
-void ThrowIfTooManyUnreadable(const Survey& survey,
-                              const ReconstructionSummary& summary) {
-  // Images that exist but cannot be decoded are only found here (loading
-  // checks existence); the same share as for missing images makes the survey
-  // invalid rather than quietly thin.
-  const int total = static_cast<int>(survey.exposures.exposures.size());
-  const double max_fraction = SurveyLoadOptions().max_missing_image_fraction;
-  if (summary.exposures_skipped == 0 ||
-      summary.exposures_skipped <= max_fraction * total) {
-    return;
-  }
-  // The skipped exposures' warnings name the image and the problem.
-  std::string first = "?";
-  for (const std::string& warning : summary.warnings) {
-    if (warning.find("skipped") != std::string::npos) {
-      first = warning;
-      break;
-    }
-  }
-  std::ostringstream problem;
-  problem << summary.exposures_skipped << " of " << total
-          << " exposures have an unreadable image (more than "
-          << max_fraction * 100 << "%); first: " << first;
-  throw InputError(survey.manifest.exposures, 0, problem.str());
-}
-
-std::vector<std::string> RunReconstructStage(
-    const Survey& survey, const ReconstructionOptions& options,
-    const std::string& results_folder,
-    const std::function<void(int, int)>& progress, RoadPlane* road_plane) {
-  std::filesystem::create_directories(results_folder);
-  std::vector<ReconstructedVertex> vertices;
-  const ReconstructionSummary summary =
-      ReconstructSurvey(survey, options, &vertices, progress);
-  ThrowIfTooManyUnreadable(survey, summary);
-  if (!summary.IsUsable()) throw StageFailedError(summary.message);
-  if (road_plane != nullptr) *road_plane = summary.final_road_plane;
-
-  StepTimings mean = summary.timings;
-  const double n = std::max(1, summary.pairs_processed);
-  mean.read_images_s /= n;
-  mean.rectify_s /= n;
-  mean.edges_s /= n;
-  mean.matching_s /= n;
-  mean.road_plane_s /= n;
-  mean.long_sides_s /= n;
-  mean.bands_s /= n;
-  mean.debug_images_s /= n;
-  std::vector<std::string> comments = {
-      "zebrageo reconstruct: " + summary.BriefReport(),
-      "per stereo pair: " + mean.Report()};
-  for (const std::string& warning : summary.warnings) {
-    comments.push_back("warning: " + warning);
-  }
-  std::vector<SkippedExposure> skipped;
-  for (const auto& [exposure_id, reason] : summary.skipped_exposures) {
-    skipped.push_back({exposure_id, reason});
-  }
-  WriteSkippedExposures(
-      skipped,
-      (std::filesystem::path(results_folder) / kSkippedExposuresFile).string());
-  WriteReconstructedBands(
-      vertices, comments,
-      (std::filesystem::path(results_folder) / kReconstructedBandsFile)
-          .string());
-  LOG(INFO) << "reconstruct: " << summary.BriefReport() << " in "
-            << summary.wall_time_s << " s";
-  LOG(INFO) << "reconstruct: " << comments[1];
-  return summary.warnings;
-}
 
 void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands) {
   auto args = std::make_shared<ReconstructArguments>();

@@ -1,22 +1,18 @@
 // `zebrageo run SURVEY -o RESULTS` and `zebrageo report SURVEY -o RESULTS`.
 #include <glog/logging.h>
-#include <sys/resource.h>
 
-#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
-#include "registration/match_stage.h"
-#include "survey/output_crs.h"
+#include "pipeline/exit_codes.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/report.h"
+#include "pipeline/results_session.h"
+#include "survey/math_util.h"
 #include "survey/results.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
-#include "tools/pipeline.h"
-#include "tools/report/report.h"
-#include "tools/results_session.h"
-#include "tools/stages.h"
+#include "tools/progress.h"
 
 namespace zebrageo {
 namespace {
@@ -32,127 +28,35 @@ struct RunArguments {
   bool rematch = true;
 };
 
-double PeakMemoryMb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
-}
-
-std::vector<std::string> SurveyInputFiles(const Survey& survey) {
-  std::vector<std::string> files = {survey.PathOf("survey.yaml")};
-  for (const std::string* file :
-       {&survey.manifest.rig, &survey.manifest.trajectory,
-        &survey.manifest.exposures, &survey.manifest.roadmarks}) {
-    files.push_back(survey.PathOf(*file));
-  }
-  for (const ExposureImage& image : survey.exposures.images) {
-    files.push_back(survey.PathOf(image.image));
-  }
-  return files;
-}
-
 void Run(const RunArguments& args) {
   // One run at a time in a results folder; on any error, no output of the
-  // contract is left (tools/results_session.h).
+  // contract is left (pipeline/results_session.h).
   ResultsSession session(args.stage.results,
                          ResultsSession::OnError::kRemoveContractOutputs);
   // Validate everything before the first output is written: a survey that
   // cannot be processed leaves a new results folder uncreated.
   const Survey survey =
       LoadSurvey(args.stage.survey, LoadOptionsOf(args.stage));
-  ReconstructionOptions reconstruction;
-  reconstruction.threads = args.threads;
-  MatchOptions matching;
-  AdjustmentOptions adjustment;
-  if (args.threads > 0) adjustment.solver.num_threads = args.threads;
-  adjustment.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
-  for (const std::string& problem :
-       {reconstruction.Check(), matching.Check(), adjustment.Check()}) {
-    if (!problem.empty()) throw UsageError(problem);
-  }
-  const std::string results = args.stage.results;
+  RunOptions options;
+  options.from_stage = args.from_stage;
+  options.tie_points = args.tie_points;
+  options.lines = args.lines;
+  options.rematch = args.rematch;
+  options.threads = args.threads;
+  options.reconstruction.threads = args.threads;
+  if (args.threads > 0) options.adjustment.solver.num_threads = args.threads;
+  options.adjustment.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
+  const std::string problem = options.Check();
+  if (!problem.empty()) throw UsageError(problem);
   session.Open();
-
-  std::vector<PipelineStage> stages;
-  std::vector<std::string> reconstruct_outputs = {kReconstructedBandsFile,
-                                                  kSkippedExposuresFile};
-  if (args.lines) reconstruct_outputs.push_back(kReconstructedLinesFile);
-  stages.push_back({"reconstruct", reconstruct_outputs,
-                    [&](const std::function<void(int, int)>& progress) {
-                      RoadPlane road_plane;
-                      std::vector<std::string> warnings =
-                          RunReconstructStage(survey, reconstruction, results,
-                                              progress, &road_plane);
-                      if (args.lines) {
-                        for (const std::string& w : RunRoadLinesStage(
-                                 survey, road_plane, RoadLineOptions(),
-                                 args.threads, results, nullptr)) {
-                          warnings.push_back(w);
-                        }
-                      }
-                      return warnings;
-                    }});
-  stages.push_back({"match",
-                    {kMatchesFile, kCrossingDecisionsFile},
-                    [&](const std::function<void(int, int)>& progress) {
-                      const MatchResult result =
-                          RunMatchStage(survey, results, matching, progress);
-                      if (!result.summary.IsUsable()) {
-                        throw StageFailedError("match: " +
-                                               result.summary.message);
-                      }
-                      LOG(INFO) << "match: " << result.summary.BriefReport();
-                      return std::vector<std::string>();
-                    }});
-  stages.push_back({"adjust",
-                    {kTrajectoryCorrectedFile, kPosesFile, kGcpResidualsFile,
-                     kBandsGeoJsonFile},
-                    [&](const std::function<void(int, int)>&) {
-                      std::vector<std::string> warnings =
-                          RunAdjustStage(survey, results, adjustment,
-                                         args.tie_points, args.lines);
-                      if (!args.rematch) return warnings;
-                      // Crossings the first pass could not decide, matched
-                      // again with the adjusted trajectory; if any is
-                      // added, the adjustment is made again with them.
-                      const RematchSummary rematch =
-                          RematchWithAdjustedTrajectory(
-                              survey, results, matching, RematchOptions());
-                      LOG(INFO) << rematch.message;
-                      // Refused for contradicting the first pass: logged as
-                      // a warning, so listed in report.json too.
-                      if (rematch.disagreements > 0) {
-                        warnings.push_back(rematch.message);
-                      }
-                      if (rematch.added == 0) {
-                        // The rematch rewrote matches.csv: its output_crs
-                        // columns again.
-                        AddOutputCrs(survey, results);
-                        return warnings;
-                      }
-                      return RunAdjustStage(survey, results, adjustment,
-                                            args.tie_points, args.lines);
-                    }});
-  std::ostringstream settings;
-  settings << "threads-independent;ties=" << args.tie_points
-           << ";lines=" << args.lines << ";sideslip=" << args.sideslip_sigma_deg
-           << ";rematch=" << args.rematch;
-  const PipelineRun run = RunPipeline(
-      results, InputFingerprint(SurveyInputFiles(survey), settings.str()),
-      stages, PipelineOptions{args.from_stage});
-
-  ReportInputs inputs;
-  inputs.survey = &survey;
-  inputs.results_folder = results;
-  inputs.timings = run.timings;
-  inputs.warnings = run.warnings;
-  inputs.peak_memory_mb = PeakMemoryMb();
-  const nlohmann::json report = WriteReport(inputs, ReportOptions());
-  for (const auto& warning : report["warnings"]) {
+  const RunSummary run =
+      RunSurveyPipeline(survey, args.stage.results, options, ProgressBars());
+  for (const auto& warning : run.report["warnings"]) {
     LOG(WARNING) << warning.get<std::string>();
   }
   session.Succeeded();
-  std::cout << "report: " << results << "/" << kReportHtmlFile << "\n";
+  std::cout << "report: " << args.stage.results << "/" << kReportHtmlFile
+            << "\n";
 }
 
 }  // namespace

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/exit_codes.h"
 #include "simulator/bad_survey.h"
 #include "simulator/simulator.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 #include "tools/progress.h"
 
 namespace zebrageo {

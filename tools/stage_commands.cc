@@ -3,9 +3,9 @@
 #include <memory>
 #include <string>
 
+#include "pipeline/exit_codes.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 
 namespace zebrageo {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/exit_codes.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
-#include "tools/exit_codes.h"
 #include "tools/version.h"
 
 namespace zebrageo {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "survey/input_error.h"
+#include "survey/results_adjustment.h"
 #include "survey/survey.h"
 #include "tests/registration/synthetic_scene.h"
 
@@ -190,10 +191,11 @@ void WriteAdjustedTrajectory(const SyntheticScene& scene,
                                      Eigen::Vector3d::Constant(1e-4)));
   }
   WriteTrajectorySamples(samples, results + "/" + kTrajectoryCorrectedFile);
-  std::ofstream(results + "/adjustment.json") << nlohmann::json{
-      {"posterior_sd_m", {{"computed", posterior}}},
-      {"counts",
-       {{"control_crossings", control_crossings}}}}.dump();
+  AdjustmentRecord adjustment;
+  adjustment.usable = true;
+  adjustment.posterior_sd_computed = posterior;
+  adjustment.counts.control_crossings = control_crossings;
+  WriteAdjustmentRecord(adjustment, results + "/" + kAdjustmentJsonFile);
 }
 
 // Three crossings whose first two bands a parked vehicle hides from every

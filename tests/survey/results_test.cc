@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -239,13 +240,17 @@ TEST(CameraPoses, ReaderRejectsNonRotationsAndBadLatitudes) {
               HasSubstr("poses.csv:2: column 'qz': \"-inf\" is not finite"));
 }
 
-TEST(GcpResiduals, WriteThenReadIsExact) {
+// The file holds 0.1 mm, 0.001 px and 0.01 in the normalized residual
+// (what the adjustment ships): read back to that resolution.
+TEST(GcpResiduals, WriteThenReadKeepsTheWrittenResolution) {
   TemporaryFolder folder;
   const std::vector<GcpResidual> residuals = {
       {"C1", 1, 0, GcpRole::kControl, Eigen::Vector3d(0.01, -0.02, 0.003), 0.4,
-       12},
+       12, GcpStatus::kControl, 0.83},
       {"C2", 3, 3, GcpRole::kCheck, Eigen::Vector3d(-1.0 / 3, 0.0, 1e-12), 0.0,
-       0}};
+       0, GcpStatus::kCheck, 0.0},
+      {"C3", 2, 1, GcpRole::kControl, Eigen::Vector3d(0.51, 0.2, -0.1), 1.23456,
+       4, GcpStatus::kRejected, 7.126}};
   const std::string path = folder.Path(kGcpResidualsFile);
   WriteGcpResiduals(residuals, path);
   EXPECT_EQ(folder.CountEntries(), 1);
@@ -257,10 +262,36 @@ TEST(GcpResiduals, WriteThenReadIsExact) {
     EXPECT_EQ(read[i].band, residuals[i].band);
     EXPECT_EQ(read[i].vertex, residuals[i].vertex);
     EXPECT_EQ(read[i].role, residuals[i].role);
-    EXPECT_LE((read[i].d_enu - residuals[i].d_enu).norm(), 1e-12);
-    EXPECT_EQ(read[i].rms_px, residuals[i].rms_px);
+    EXPECT_EQ(read[i].status, residuals[i].status);
+    EXPECT_LE((read[i].d_enu - residuals[i].d_enu).cwiseAbs().maxCoeff(),
+              0.5e-4);
+    EXPECT_NEAR(read[i].rms_px, residuals[i].rms_px, 0.5e-3);
     EXPECT_EQ(read[i].n_images, residuals[i].n_images);
+    EXPECT_NEAR(read[i].normalized_residual, residuals[i].normalized_residual,
+                0.5e-2);
   }
+  // Written again, the file is the same.
+  const std::string again = folder.Path("again.csv");
+  WriteGcpResiduals(read, again);
+  std::ifstream a(path), b(again);
+  std::stringstream text_a, text_b;
+  text_a << a.rdbuf();
+  text_b << b.rdbuf();
+  EXPECT_EQ(text_a.str(), text_b.str());
+}
+
+TEST(GcpResiduals, FilesWithoutStatusTakeTheRole) {
+  TemporaryFolder folder;
+  const std::string path =
+      folder.Write("g.csv",
+                   "crossing_id,band,vertex,role,de,dn,du,d3d,rms_px,n_images\n"
+                   "C1,1,0,control,0,0,0,0,0.1,3\n"
+                   "C1,1,1,check,0,0,0,0,0.1,3\n");
+  const std::vector<GcpResidual> read =
+      ReadGcpResiduals(path, kGcpResidualsFile);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].status, GcpStatus::kControl);
+  EXPECT_EQ(read[1].status, GcpStatus::kCheck);
 }
 
 TEST(GcpResiduals, ReaderRejectsUnknownRoles) {

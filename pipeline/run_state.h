@@ -1,4 +1,5 @@
-// Runs stages in order into one results folder, resumably.
+// Runs stages in order into one results folder, resumably (the run state
+// of `zebrageo run`).
 //
 // After a stage's outputs are complete (each written atomically), the
 // pipeline records it in RESULTS/run_state.json with a fingerprint of the
@@ -8,14 +9,15 @@
 // from a named stage. Killing a run therefore loses at most the stage in
 // progress, and the rerun gives the same results as an uninterrupted run
 // because every stage is deterministic.
-#ifndef ZEBRAGEO_TOOLS_PIPELINE_H_
-#define ZEBRAGEO_TOOLS_PIPELINE_H_
+#ifndef ZEBRAGEO_PIPELINE_RUN_STATE_H_
+#define ZEBRAGEO_PIPELINE_RUN_STATE_H_
 
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "tools/report/report.h"
+#include "pipeline/progress.h"
+#include "pipeline/report.h"
 
 namespace zebrageo {
 
@@ -53,8 +55,9 @@ std::string InputFingerprint(const std::vector<std::string>& input_files,
 PipelineRun RunPipeline(const std::string& results_folder,
                         const std::string& fingerprint,
                         const std::vector<PipelineStage>& stages,
-                        const PipelineOptions& options);
+                        const PipelineOptions& options,
+                        const ProgressListener& progress = {});
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_PIPELINE_H_
+#endif  // ZEBRAGEO_PIPELINE_RUN_STATE_H_

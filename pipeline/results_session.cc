@@ -1,4 +1,4 @@
-#include "tools/results_session.h"
+#include "pipeline/results_session.h"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -10,8 +10,8 @@
 #include <string>
 #include <utility>
 
+#include "pipeline/exit_codes.h"
 #include "survey/results.h"
-#include "tools/exit_codes.h"
 
 namespace zebrageo {
 namespace {

@@ -1,4 +1,4 @@
-#include "tools/report/svg_plot.h"
+#include "pipeline/svg_plot.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,6 @@
-// The road-line stage (issue 9): reconstructed_lines.csv from the stereo
-// pairs, on the road plane the zebra stage estimated; and the road lines as
-// control in the adjustment (matched with the trajectory the zebra
-// crossings corrected, then a second adjustment with the lines).
+// The road lines as control in the adjustment (issue 9): matched with the
+// trajectory the zebra crossings corrected, then a second adjustment with
+// the lines (pipeline/adjust_stage.cc).
 #include <glog/logging.h>
 
 #include <algorithm>
@@ -10,20 +9,17 @@
 #include <filesystem>
 #include <iomanip>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include "pipeline/stages.h"
 #include "reconstruction/road_lines.h"
 #include "registration/line_matcher.h"
-#include "survey/atomic_file.h"
-#include "survey/csv.h"
 #include "survey/math_util.h"
-#include "tools/exit_codes.h"
-#include "tools/stages.h"
+#include "survey/results_lines.h"
 
 namespace zebrageo {
 namespace {
@@ -98,67 +94,7 @@ std::vector<RejectedLine> RejectLinesAwayFromTrajectory(
   return rejected;
 }
 
-// line_control.json: what the road lines controlled, per stretch of
-// stretch_s seconds from the first exposure (tools/report reads it).
-void WriteLineControlSummary(const std::map<int, std::array<int, 3>>& stretches,
-                             double stretch_s, double start_time,
-                             size_t reconstructed_points, size_t matched_points,
-                             size_t used_points, const nlohmann::json& rejected,
-                             const std::string& results_folder) {
-  nlohmann::json j;
-  j["stretch_s"] = stretch_s;
-  j["reconstructed_points"] = reconstructed_points;
-  j["matched_points"] = matched_points;
-  j["used_points"] = used_points;
-  j["rejected_lines"] = rejected;
-  j["note"] =
-      "a road line constrains the position across itself and the height, "
-      "never along itself: lane lines control cross-track and height; stop "
-      "lines the height only (the zebra crossings beside them hold the "
-      "along-track position)";
-  nlohmann::json list = nlohmann::json::array();
-  for (const auto& [k, s] : stretches) {
-    nlohmann::json controlled = nlohmann::json::array();
-    if (s[0] > 0) controlled.push_back("cross-track");
-    if (s[1] > 0) controlled.push_back("height");
-    if (s[2] > 0) controlled.push_back("along-track");
-    list.push_back({{"t0_s", k * stretch_s},
-                    {"t1_s", (k + 1) * stretch_s},
-                    {"time0", start_time + k * stretch_s},
-                    {"cross_track_points", s[0]},
-                    {"height_points", s[1]},
-                    {"along_track_points", s[2]},
-                    {"controlled", controlled}});
-  }
-  j["stretches"] = list;
-  AtomicFile file(
-      (std::filesystem::path(results_folder) / kLineControlFile).string());
-  file.stream() << j.dump(2) << "\n";
-  file.Commit();
-}
-
 }  // namespace
-
-std::vector<std::string> RunRoadLinesStage(
-    const Survey& survey, const RoadPlane& road_plane,
-    const RoadLineOptions& options, int threads,
-    const std::string& results_folder,
-    const std::function<void(int, int)>& progress) {
-  const std::string error = options.Check();
-  if (!error.empty()) throw StageFailedError(error);
-  std::filesystem::create_directories(results_folder);
-  std::vector<ReconstructedLinePoint> points;
-  const RoadLineSummary summary = ExtractSurveyLines(
-      survey, road_plane, options, threads, &points, progress);
-  std::vector<std::string> warnings;
-  if (summary.lines == 0) warnings.push_back("no road line was reconstructed");
-  WriteReconstructedLines(
-      points, {"zebrageo reconstruct --lines: " + summary.BriefReport()},
-      (std::filesystem::path(results_folder) / kReconstructedLinesFile)
-          .string());
-  LOG(INFO) << "road lines: " << summary.BriefReport();
-  return warnings;
-}
 
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
@@ -220,7 +156,7 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
        RejectLinesAwayFromTrajectory(consistent, sd_of_point, &matches)) {
     rejected.push_back(r);
   }
-  nlohmann::json rejected_json = nlohmann::json::array();
+  LineControlRecord summary;
   for (const RejectedLine& r : rejected) {
     const DatabaseLineEnu& line = database[r.db_line];
     // The report's wording (tools/report/report.cc), so the warning is
@@ -232,27 +168,17 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
          "not used as control";
     LOG(WARNING) << w.str();
     warnings->push_back(w.str());
-    rejected_json.push_back({{"db_line", line.id},
-                             {"type", line.type},
-                             {"points", r.points},
-                             {"offset_m", r.offset_m}});
+    summary.rejected_lines.push_back(
+        {line.id, line.type, r.points, r.offset_m});
   }
 
-  AtomicFile file(
-      (std::filesystem::path(results_folder) / "line_matches.csv").string());
-  CsvWriter csv(&file.stream());
-  csv.Comment(
-      "road-line points matched to database lines (issue 9); each constrains "
-      "the position across the line (across_e, across_n) and the height, "
-      "never along the line");
+  std::vector<LineMatch> rows;
   // Per 30 s stretch: matches, and the directions controlled.
   const double stretch_s = 30.0;
   const double start_time = data.exposures.exposures.empty()
                                 ? 0.0
                                 : data.exposures.exposures.front().time;
   std::map<int, std::array<int, 3>> stretches;  // cross-track, height, along
-  csv.Header({"exposure_id", "line_id", "point", "type", "db_line", "across_e",
-              "across_n", "distance_m", "height_m", "constrains"});
   // The database's error is one per segment, shared by every point matched
   // to it (from several exposures): counted once, or the adjustment would
   // fit the database's noise (the heading follows the digitised line's
@@ -295,22 +221,21 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
         std::floor((c.time - start_time) / stretch_s))];
     if (cross_track) s[0] += 1;
     s[1] += 1;
-    csv.Add(p.exposure_id)
-        .Add(p.line_id)
-        .Add(p.point)
-        .Add(RoadLineTypeName(p.type))
-        .Add(line.id)
-        .Add(m.across_enu.x())
-        .Add(m.across_enu.y())
-        .Add(m.distance_m)
-        .Add(m.height_m)
-        .Add(cross_track ? "across+height" : "height");
-    csv.EndRow();
+    rows.push_back({p.exposure_id, p.line_id, p.point, p.type, line.id,
+                    m.across_enu.head<2>(), m.distance_m, m.height_m,
+                    cross_track});
   }
-  file.Commit();
-  WriteLineControlSummary(stretches, stretch_s, start_time, points.size(),
-                          all_matches.size(), matches.size(), rejected_json,
-                          results_folder);
+  const std::filesystem::path folder(results_folder);
+  WriteLineMatches(rows, (folder / kLineMatchesFile).string());
+  summary.stretch_s = stretch_s;
+  summary.reconstructed_points = static_cast<int64_t>(points.size());
+  summary.matched_points = static_cast<int64_t>(all_matches.size());
+  summary.used_points = static_cast<int64_t>(matches.size());
+  for (const auto& [k, s] : stretches) {
+    summary.stretches.push_back({k * stretch_s, (k + 1) * stretch_s,
+                                 start_time + k * stretch_s, s[0], s[1], s[2]});
+  }
+  WriteLineControl(summary, (folder / kLineControlFile).string());
   std::ostringstream report;
   report << "road lines: " << matches.size() << " of " << points.size()
          << " line points matched to database lines; per " << stretch_s

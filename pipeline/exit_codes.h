@@ -1,6 +1,6 @@
 // Exit status of the zebrageo command (README.md, "Exit status").
-#ifndef ZEBRAGEO_TOOLS_EXIT_CODES_H_
-#define ZEBRAGEO_TOOLS_EXIT_CODES_H_
+#ifndef ZEBRAGEO_PIPELINE_EXIT_CODES_H_
+#define ZEBRAGEO_PIPELINE_EXIT_CODES_H_
 
 #include <stdexcept>
 #include <string>
@@ -44,4 +44,4 @@ class StageFailedError : public std::runtime_error {
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_EXIT_CODES_H_
+#endif  // ZEBRAGEO_PIPELINE_EXIT_CODES_H_

@@ -15,8 +15,8 @@
 // command refused because another one runs there never touches its files.
 // Stage outputs (reconstructed_bands.csv...) stay, so a fixed survey
 // resumes.
-#ifndef ZEBRAGEO_TOOLS_RESULTS_SESSION_H_
-#define ZEBRAGEO_TOOLS_RESULTS_SESSION_H_
+#ifndef ZEBRAGEO_PIPELINE_RESULTS_SESSION_H_
+#define ZEBRAGEO_PIPELINE_RESULTS_SESSION_H_
 
 #include <string>
 
@@ -55,4 +55,4 @@ class ResultsSession {
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_RESULTS_SESSION_H_
+#endif  // ZEBRAGEO_PIPELINE_RESULTS_SESSION_H_

@@ -1,4 +1,4 @@
-#include "tools/pipeline.h"
+#include "pipeline/run_state.h"
 
 #include <glog/logging.h>
 
@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "pipeline/exit_codes.h"
+#include "pipeline/progress.h"
 #include "survey/atomic_file.h"
-#include "tools/exit_codes.h"
-#include "tools/progress.h"
 #include "tools/version.h"
 
 namespace zebrageo {
@@ -81,7 +81,8 @@ std::string InputFingerprint(const std::vector<std::string>& input_files,
 PipelineRun RunPipeline(const std::string& results_folder,
                         const std::string& fingerprint,
                         const std::vector<PipelineStage>& stages,
-                        const PipelineOptions& options) {
+                        const PipelineOptions& options,
+                        const ProgressListener& progress) {
   int from_index = -1;
   if (!options.from_stage.empty()) {
     for (size_t i = 0; i < stages.size(); ++i) {
@@ -126,10 +127,10 @@ PipelineRun RunPipeline(const std::string& results_folder,
     // never leaves it looking complete.
     record = json{{"complete", false}};
     WriteState(state_path, state);
-    ProgressBar bar(stage.name);
-    const std::vector<std::string> warnings = stage.run(bar.Callback());
-    bar.Finish();
-    const double seconds = bar.ElapsedSeconds();
+    StepProgress step(progress, stage.name);
+    const std::vector<std::string> warnings = stage.run(step.Callback());
+    step.Finish();
+    const double seconds = step.ElapsedSeconds();
     record =
         json{{"complete", true}, {"seconds", seconds}, {"warnings", warnings}};
     WriteState(state_path, state);

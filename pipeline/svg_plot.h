@@ -1,8 +1,8 @@
 // Minimal SVG charts for the self-contained HTML report: line and scatter
 // plots with axes and ticks, colour-mapped points, arrows and histograms.
 // No network, no JavaScript: the SVG is inlined in report.html.
-#ifndef ZEBRAGEO_TOOLS_REPORT_SVG_PLOT_H_
-#define ZEBRAGEO_TOOLS_REPORT_SVG_PLOT_H_
+#ifndef ZEBRAGEO_PIPELINE_SVG_PLOT_H_
+#define ZEBRAGEO_PIPELINE_SVG_PLOT_H_
 
 #include <string>
 #include <vector>
@@ -67,4 +67,4 @@ std::string EscapeHtml(const std::string& text);
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_REPORT_SVG_PLOT_H_
+#endif  // ZEBRAGEO_PIPELINE_SVG_PLOT_H_

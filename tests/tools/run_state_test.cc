@@ -1,4 +1,6 @@
-#include "tools/pipeline.h"
+#include "pipeline/run_state.h"
+
+#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
@@ -6,10 +8,8 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
+#include "pipeline/exit_codes.h"
 #include "tests/survey/test_util.h"
-#include "tools/exit_codes.h"
 
 namespace zebrageo {
 namespace {

@@ -6,8 +6,8 @@
 // crossing_decisions.csv, matches.csv, match_evidence.json,
 // adjustment.json, reconstruction.json) and the run's stage timings.
 // Missing files only remove sections; they are listed as warnings.
-#ifndef ZEBRAGEO_TOOLS_REPORT_REPORT_H_
-#define ZEBRAGEO_TOOLS_REPORT_REPORT_H_
+#ifndef ZEBRAGEO_PIPELINE_REPORT_H_
+#define ZEBRAGEO_PIPELINE_REPORT_H_
 
 #include <nlohmann/json.hpp>
 #include <string>
@@ -58,4 +58,4 @@ nlohmann::json WriteReport(const ReportInputs& inputs,
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_TOOLS_REPORT_REPORT_H_
+#endif  // ZEBRAGEO_PIPELINE_REPORT_H_

@@ -1,0 +1,167 @@
+// MatchLinesForAdjustment against a simulated survey's truth: a vehicle
+// driving east between painted lane lines, the reconstructed line points
+// exactly where the true trajectory puts them, one database line drawn
+// 25 cm away from its paint (repainted).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "pipeline/stages.h"
+#include "survey/results_lines.h"
+#include "tests/survey/test_util.h"
+
+namespace zebrageo {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kSpeedMps = 10.0;
+constexpr double kCameraHeightM = 2.0;
+
+// The true pose at `time`, heading east: body (FRD) x forward = east, y
+// right = south, z down.
+Pose TruePose(double time) {
+  Pose pose;
+  pose.p_enu = Eigen::Vector3d(kSpeedMps * time, 0.0, kCameraHeightM);
+  pose.q_enu_body =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+  return pose;
+}
+
+struct PaintedLine {
+  std::string id;
+  std::string type;
+  double north_m;           // where it is painted
+  double database_north_m;  // where the database draws it
+};
+
+class MatchLinesForAdjustmentTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    lines_ = {{"L1", "lane_solid", 1.75, 1.75},
+              {"L2", "lane_dashed", -1.75, -1.75},
+              {"L3", "lane_solid", 5.25, 5.25},
+              {"stale", "lane_solid", -5.0, -5.25}};
+    data_.frame = LocalFrame(Geodetic{48.85, 2.35, 50.0});
+    for (const PaintedLine& line : lines_) {
+      RoadmarkLine db;
+      db.id = line.id;
+      db.type = line.type;
+      db.sigma_xy_m = 0.03;
+      db.sigma_z_m = 0.03;
+      for (double east = -20.0; east <= 260.0; east += 20.0) {
+        db.points.push_back(data_.frame.GeodeticFromEnu(
+            Eigen::Vector3d(east, line.database_north_m, 0.0)));
+      }
+      data_.roadmarks.lines.push_back(db);
+    }
+    // The zebra-corrected trajectory is the truth, its posterior sd 2 cm.
+    for (int i = 0; i <= 220; ++i) {
+      TrajectorySample sample;
+      sample.time = 0.1 * i;
+      sample.sd_enu_m = Eigen::Vector3d(0.02, 0.02, 0.02);
+      zebra_.corrected_samples.push_back(sample);
+      zebra_.corrected_poses.push_back(TruePose(sample.time));
+    }
+    // One exposure every 0.5 s; each sees every line from 4 to 12 m ahead.
+    std::vector<ReconstructedLinePoint> points;
+    int64_t line_id = 0;
+    for (int e = 0; e < 40; ++e) {
+      Exposure exposure;
+      exposure.exposure_id = 1000 + e;
+      exposure.time = 0.5 * e;
+      data_.exposures.exposures.push_back(exposure);
+      const Pose pose = TruePose(exposure.time);
+      for (const PaintedLine& line : lines_) {
+        ++line_id;
+        for (int k = 0; k < 5; ++k) {
+          const Eigen::Vector3d p_enu(pose.p_enu.x() + 4.0 + 2.0 * k,
+                                      line.north_m, 0.0);
+          ReconstructedLinePoint p;
+          p.exposure_id = exposure.exposure_id;
+          p.line_id = line_id;
+          p.type = line.type == "lane_dashed" ? RoadLineType::kLaneDashed
+                                              : RoadLineType::kLaneSolid;
+          p.point = k;
+          p.p_body = pose.T_enu_body().inverse() * p_enu;
+          p.covariance_body = Eigen::Matrix3d::Identity() * 1e-4;
+          points.push_back(p);
+        }
+      }
+    }
+    WriteReconstructedLines(points, {"test"},
+                            folder_.Path(kReconstructedLinesFile));
+    points_per_line_ = 40 * 5;
+  }
+
+  std::vector<PaintedLine> lines_;
+  AdjustmentData data_;
+  AdjustmentResult zebra_;
+  TemporaryFolder folder_;
+  int points_per_line_ = 0;
+};
+
+TEST_F(MatchLinesForAdjustmentTest, ControlLiesOnThePaintAndTheStaleLineIsOut) {
+  std::vector<std::string> warnings;
+  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
+      data_, AdjustmentOptions(), zebra_, folder_.Path(), &warnings);
+
+  // Nearly every point of the three true lines is control (the database
+  // lines are long enough for all of them).
+  EXPECT_GE(static_cast<int>(control.size()), 3 * points_per_line_ * 9 / 10);
+  EXPECT_LE(static_cast<int>(control.size()), 3 * points_per_line_);
+  for (const LineControlPoint& c : control) {
+    // The point placed with the true pose lies on its database line: across
+    // the line within 1 mm, at the database's height.
+    const Eigen::Vector3d p_enu = TruePose(c.time).T_enu_body() * c.p_body;
+    EXPECT_NEAR((p_enu - c.db_point_enu).dot(c.across_enu), 0.0, 1e-3);
+    EXPECT_NEAR(p_enu.z() - c.db_point_enu.z(), 0.0, 1e-3);
+    // Lane lines run with the vehicle: across them is cross-track (north).
+    EXPECT_NEAR(std::abs(c.across_enu.y()), 1.0, 1e-6);
+    EXPECT_GT(c.sqrt_information.row(0).norm(), 0.0);
+    // Never the stale line's paint (5 m right of the vehicle).
+    EXPECT_GT(p_enu.y(), -4.0);
+  }
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_THAT(warnings.back(), HasSubstr("road line stale (lane_solid)"));
+
+  // The files of the contract say the same.
+  const std::vector<LineMatch> rows =
+      ReadLineMatches(folder_.Path(kLineMatchesFile), kLineMatchesFile);
+  EXPECT_EQ(rows.size(), control.size());
+  for (const LineMatch& row : rows) EXPECT_NE(row.db_line, "stale");
+  const LineControlRecord summary =
+      ReadLineControl(folder_.Path(kLineControlFile), kLineControlFile);
+  EXPECT_EQ(summary.reconstructed_points, 4 * points_per_line_);
+  EXPECT_EQ(summary.used_points, static_cast<int64_t>(control.size()));
+  ASSERT_EQ(summary.rejected_lines.size(), 1u);
+  EXPECT_EQ(summary.rejected_lines[0].db_line, "stale");
+  EXPECT_NEAR(std::abs(summary.rejected_lines[0].offset_m), 0.25, 0.02);
+  ASSERT_FALSE(summary.stretches.empty());
+  EXPECT_GT(summary.stretches[0].cross_track_points, 0);
+}
+
+TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
+  TemporaryFolder empty;
+  std::vector<std::string> warnings;
+  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
+                                      empty.Path(), &warnings)
+                  .empty());
+  EXPECT_TRUE(warnings.empty());
+}
+
+TEST_F(MatchLinesForAdjustmentTest, ADatabaseWithoutLinesIsAWarning) {
+  data_.roadmarks.lines.clear();
+  std::vector<std::string> warnings;
+  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
+                                      folder_.Path(), &warnings)
+                  .empty());
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_THAT(warnings[0], HasSubstr("no lines"));
+}
+
+}  // namespace
+}  // namespace zebrageo
