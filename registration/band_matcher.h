@@ -14,7 +14,7 @@
 // with p_measured = q_enu_body * p_body + p_enu placed with the measured
 // pose. Height is left to the adjustment (a zebra is flat).
 //
-// Method (details in band_matcher.cc):
+// Method (one file per step: band_matcher_internal.h lists them):
 //  1. Hypotheses. For each observation (the bands of one reconstructed
 //     crossing group in one exposure) every pairing of an observed band with
 //     a database band of compatible shape inside the drift gate gives a

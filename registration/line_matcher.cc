@@ -8,6 +8,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
@@ -259,12 +261,6 @@ std::string LineConsistencyOptions::Check() const {
 
 namespace {
 
-double MedianOf(std::vector<double>* values) {
-  auto mid = values->begin() + values->size() / 2;
-  std::nth_element(values->begin(), mid, values->end());
-  return *mid;
-}
-
 // The matches of one database line within one second: their median
 // distance across the line, the line's normal there, and how many.
 struct LineSecond {
@@ -291,7 +287,7 @@ std::vector<LineSecond> LineSeconds(const std::vector<LinePointMatch>& matches,
     LineSecond s;
     s.db_line = key.first;
     s.second = key.second;
-    s.distance_m = MedianOf(&distances);
+    s.distance_m = Median(distances);
     s.across = matches[members.front()].across_enu.head<2>();
     s.points = static_cast<int>(members.size());
     seconds.push_back(s);
@@ -333,16 +329,16 @@ std::vector<RejectedLine> RejectInconsistentLines(
     }
     if (other_lines.empty()) continue;
     references.clear();
-    for (auto& [line, values] : other_lines) {
-      references.push_back(MedianOf(&values));
+    for (const auto& [line, values] : other_lines) {
+      references.push_back(Median(values));
     }
-    offsets_of_line[s.db_line].push_back(s.distance_m - MedianOf(&references));
+    offsets_of_line[s.db_line].push_back(s.distance_m - Median(references));
     points_of_line[s.db_line] += s.points;
   }
   std::vector<RejectedLine> rejected;
-  for (auto& [line, offsets] : offsets_of_line) {
+  for (const auto& [line, offsets] : offsets_of_line) {
     if (points_of_line[line] < options.min_points) continue;
-    const double offset = MedianOf(&offsets);
+    const double offset = Median(offsets);
     if (std::abs(offset) > options.max_offset_m) {
       rejected.push_back({line, points_of_line[line], offset});
     }

@@ -11,6 +11,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
@@ -26,13 +28,6 @@ using Tree = bgi::rtree<TreeValue, bgi::quadratic<16>>;
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
 }
 
 // Mean of axes (directions up to sign): average the doubled angles.
