@@ -8,7 +8,6 @@
 #include <ctime>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/ximgproc.hpp>
 #include <sstream>
 #include <thread>
 
