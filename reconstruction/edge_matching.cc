@@ -6,6 +6,8 @@
 #include <sstream>
 #include <utility>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
@@ -59,12 +61,6 @@ bool Matchable(const EdgePoint& e, double min_sin) {
   return std::abs(e.gx) >= min_sin * e.norm;
 }
 
-double Median(std::vector<double>* values) {
-  const size_t mid = values->size() / 2;
-  std::nth_element(values->begin(), values->begin() + mid, values->end());
-  return (*values)[mid];
-}
-
 // Local disparity of every point of every left chain: the median of the
 // matched disparities within +-half_window chain positions (NaN when fewer
 // than 3).
@@ -82,7 +78,7 @@ std::vector<double> ChainDisparities(const EdgeMap& left,
         const double d = disparity[chain[m]];
         if (!std::isnan(d)) window.push_back(d);
       }
-      if (window.size() >= 3) reference[chain[k]] = Median(&window);
+      if (window.size() >= 3) reference[chain[k]] = Median(window);
     }
   }
   return reference;

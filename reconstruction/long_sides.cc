@@ -8,152 +8,13 @@
 #include <numeric>
 #include <sstream>
 
+#include "reconstruction/segment_grouping.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
 
 constexpr int kDirectionBins = 180;
-
-// Total least squares line through 2D points: centre and unit direction.
-void FitLine2d(const std::vector<Eigen::Vector2d>& points,
-               const std::vector<int>& support, Eigen::Vector2d* centre,
-               Eigen::Vector2d* direction) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (int i : support) mean += points[i];
-  mean /= static_cast<double>(support.size());
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (int i : support) {
-    scatter += (points[i] - mean) * (points[i] - mean).transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
-  *centre = mean;
-  *direction = solver.eigenvectors().col(1);
-}
-
-// A set of collinear supports being grouped.
-struct Group {
-  std::vector<int> support;
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();  // along `axis`
-  double t_min = 0.0;  // extent along direction from centre
-  double t_max = 0.0;
-  double rms_m = 0.0;  // perpendicular residuals
-  // +1 when the image brightens across the group towards the left of
-  // `axis`, -1 the other way: one edge of a paint mark keeps its polarity.
-  int polarity = 1;
-  double Length() const { return t_max - t_min; }
-  Eigen::Vector2d Begin() const { return centre + t_min * direction; }
-  Eigen::Vector2d End() const { return centre + t_max * direction; }
-};
-
-Group MakeGroup(const std::vector<Eigen::Vector2d>& points,
-                std::vector<int> support, const Eigen::Vector2d& axis) {
-  Group g;
-  g.support = std::move(support);
-  FitLine2d(points, g.support, &g.centre, &g.direction);
-  if (g.direction.dot(axis) < 0.0) g.direction = -g.direction;
-  const Eigen::Vector2d normal(-g.direction.y(), g.direction.x());
-  g.t_min = 1e30;
-  g.t_max = -1e30;
-  double sum_squares = 0.0;
-  for (int i : g.support) {
-    const Eigen::Vector2d d = points[i] - g.centre;
-    const double t = d.dot(g.direction);
-    g.t_min = std::min(g.t_min, t);
-    g.t_max = std::max(g.t_max, t);
-    sum_squares += d.dot(normal) * d.dot(normal);
-  }
-  g.rms_m = std::sqrt(sum_squares / g.support.size());
-  return g;
-}
-
-double PerpendicularDistance(const Group& g, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d d = p - g.centre;
-  return std::abs(d.x() * g.direction.y() - d.y() * g.direction.x());
-}
-
-struct GroupingThresholds {
-  double max_gap_m;
-  double max_offset_m;
-  double max_angle_rad;
-};
-
-// Greedy best-first merging of collinear groups (an approximation of Jang
-// and Hong's globally favourable grouping): candidate links are sorted by a
-// normalised cost of gap, offset and angle, and merged while the merged
-// group stays a line (rms below the offset threshold).
-std::vector<Group> MergeCollinear(const std::vector<Eigen::Vector2d>& points,
-                                  std::vector<Group> groups,
-                                  const Eigen::Vector2d& axis,
-                                  const GroupingThresholds& limits) {
-  for (bool merged = true; merged;) {
-    merged = false;
-    struct Link {
-      double cost;
-      int i, j;
-    };
-    std::vector<Link> links;
-    const int n = static_cast<int>(groups.size());
-    for (int i = 0; i < n; ++i) {
-      for (int j = i + 1; j < n; ++j) {
-        const Group& a = groups[i];
-        const Group& b = groups[j];
-        // A band's side running on into a lane line's opposite edge, or a
-        // shadow boundary, collinear with it is not one line.
-        if (a.polarity != b.polarity) continue;
-        const double angle =
-            std::acos(std::min(1.0, std::abs(a.direction.dot(b.direction))));
-        // A short group's direction is uncertain: its angle may exceed the
-        // threshold as long as its ends stay within the offset (below).
-        const double shorter_length = std::min(a.Length(), b.Length());
-        const double max_angle =
-            std::max(limits.max_angle_rad,
-                     std::atan2(limits.max_offset_m, 0.5 * shorter_length));
-        if (angle > max_angle) continue;
-        const double a0 = (a.Begin() - a.centre).dot(axis) + a.centre.dot(axis);
-        const double a1 = (a.End() - a.centre).dot(axis) + a.centre.dot(axis);
-        const double b0 = (b.Begin() - b.centre).dot(axis) + b.centre.dot(axis);
-        const double b1 = (b.End() - b.centre).dot(axis) + b.centre.dot(axis);
-        const double gap = std::max(b0 - a1, a0 - b1);
-        if (gap > limits.max_gap_m) continue;
-        // The shorter group's ends must lie on the longer group's line.
-        const Group& longer = a.Length() >= b.Length() ? a : b;
-        const Group& shorter = a.Length() >= b.Length() ? b : a;
-        const double offset =
-            std::max(PerpendicularDistance(longer, shorter.Begin()),
-                     PerpendicularDistance(longer, shorter.End()));
-        if (offset > limits.max_offset_m) continue;
-        links.push_back({std::max(0.0, gap) / limits.max_gap_m +
-                             offset / limits.max_offset_m + angle / max_angle,
-                         i, j});
-      }
-    }
-    std::sort(links.begin(), links.end(), [](const Link& x, const Link& y) {
-      return x.cost < y.cost || (x.cost == y.cost && x.i < y.i) ||
-             (x.cost == y.cost && x.i == y.i && x.j < y.j);
-    });
-    std::vector<char> touched(groups.size(), 0);
-    std::vector<Group> next;
-    for (const Link& link : links) {
-      if (touched[link.i] || touched[link.j]) continue;
-      std::vector<int> support = groups[link.i].support;
-      support.insert(support.end(), groups[link.j].support.begin(),
-                     groups[link.j].support.end());
-      Group joined = MakeGroup(points, std::move(support), axis);
-      joined.polarity = groups[link.i].polarity;
-      if (joined.rms_m > limits.max_offset_m) continue;
-      touched[link.i] = touched[link.j] = 1;
-      next.push_back(std::move(joined));
-      merged = true;
-    }
-    for (int i = 0; i < n; ++i) {
-      if (!touched[i]) next.push_back(std::move(groups[i]));
-    }
-    groups = std::move(next);
-  }
-  return groups;
-}
 
 }  // namespace
 
@@ -522,12 +383,22 @@ LongSide FitLongSide(const std::vector<EdgePoint3d>& points,
   return side;
 }
 
-LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
-                                  const PlaneFrame& frame,
-                                  const ZebraSpecification& zebra,
-                                  const LongSideOptions& options) {
-  LongSideDetection result;
-  // Flatten, polygonise, refine each polygon side by regression.
+void SideExtent(const PlaneFrame& frame, const LongSide& side,
+                const Eigen::Vector2d& along, double* low, double* high) {
+  const double a = frame.To2d(side.Begin()).dot(along);
+  const double b = frame.To2d(side.End()).dot(along);
+  *low = std::min(a, b);
+  *high = std::max(a, b);
+}
+
+namespace {
+
+// Flattens the chains into `result` (points, points_2d) and polygonises
+// them: each polygon side refined by regression becomes a segment.
+void PolygonSegments(const std::vector<EdgeChain3d>& chains,
+                     const PlaneFrame& frame, const LongSideOptions& options,
+                     LongSideDetection* detection) {
+  LongSideDetection& result = *detection;
   for (const EdgeChain3d& chain : chains) {
     const int first_index = static_cast<int>(result.points.size());
     for (const EdgePoint3d& p : chain.points) {
@@ -564,6 +435,64 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
       start = k;
     }
   }
+}
+
+// The long sides of one paired accumulator component of direction set
+// `set`: its segments among `members`, grouped in two passes, those
+// longer than L_min fitted in 3D and appended to result.sides.
+void ComponentSides(const std::vector<Segment2d>& members,
+                    const AccumulatorComponent& component,
+                    const Eigen::Vector2d& direction, int set,
+                    const PlaneFrame& frame, const LongSideOptions& options,
+                    LongSideDetection* detection) {
+  LongSideDetection& result = *detection;
+  const Eigen::Vector2d normal(-direction.y(), direction.x());
+  std::vector<Group> groups;
+  for (const Segment2d& s : members) {
+    const double middle = 0.5 * (s.a + s.b).dot(normal);
+    if (middle < component.low_m - options.accumulator_cell_m ||
+        middle > component.high_m + options.accumulator_cell_m) {
+      continue;
+    }
+    groups.push_back(MakeGroup(result.points_2d, s.support, direction));
+    double contrast = 0.0;
+    for (int i : s.support) {
+      contrast += result.points[i].gradient.dot(normal);
+    }
+    groups.back().polarity = contrast >= 0.0 ? 1 : -1;
+  }
+  groups = MergeCollinear(result.points_2d, std::move(groups), direction,
+                          {options.pass1_max_gap_m, options.pass1_max_offset_m,
+                           options.pass1_max_angle_rad});
+  groups.erase(std::remove_if(groups.begin(), groups.end(),
+                              [&](const Group& g) {
+                                return g.Length() < options.pass1_min_length_m;
+                              }),
+               groups.end());
+  groups = MergeCollinear(result.points_2d, std::move(groups), direction,
+                          {options.pass2_max_gap_m, options.pass2_max_offset_m,
+                           options.pass2_max_angle_rad});
+  for (Group& g : groups) {
+    VLOG(3) << "  group length " << g.Length() << " rms " << g.rms_m;
+    if (g.Length() < options.min_long_side_length_m) continue;
+    LongSide side =
+        FitLongSide(result.points, std::move(g.support), frame, direction, set);
+    VLOG(2) << "long side " << result.sides.size() << ": set " << set
+            << " lateral " << side.lateral_m << " extent " << side.t_begin
+            << " " << side.t_end << " contrast " << side.contrast << " points "
+            << side.support.size();
+    result.sides.push_back(std::move(side));
+  }
+}
+
+}  // namespace
+
+LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
+                                  const PlaneFrame& frame,
+                                  const ZebraSpecification& zebra,
+                                  const LongSideOptions& options) {
+  LongSideDetection result;
+  PolygonSegments(chains, frame, options, &result);
 
   const double min_set_length =
       2.0 * options.high_vote_fraction * zebra.min_band_length_m;
@@ -593,7 +522,6 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
     }
     const std::vector<AccumulatorComponent> components =
         ParallelLineComponents(members, direction, zebra, options);
-    const Eigen::Vector2d normal(-direction.y(), direction.x());
     for (const AccumulatorComponent& component : components) {
       VLOG(3) << "set " << set << " component at " << component.lateral_m
               << " m [" << component.low_m << ", " << component.high_m
@@ -601,45 +529,8 @@ LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
               << (component.paired ? "paired" : "alone");
       if (!component.paired) continue;
       // Segments of the component, grouped in two passes.
-      std::vector<Group> groups;
-      for (const Segment2d& s : members) {
-        const double middle = 0.5 * (s.a + s.b).dot(normal);
-        if (middle < component.low_m - options.accumulator_cell_m ||
-            middle > component.high_m + options.accumulator_cell_m) {
-          continue;
-        }
-        groups.push_back(MakeGroup(result.points_2d, s.support, direction));
-        double contrast = 0.0;
-        for (int i : s.support) {
-          contrast += result.points[i].gradient.dot(normal);
-        }
-        groups.back().polarity = contrast >= 0.0 ? 1 : -1;
-      }
-      groups =
-          MergeCollinear(result.points_2d, std::move(groups), direction,
-                         {options.pass1_max_gap_m, options.pass1_max_offset_m,
-                          options.pass1_max_angle_rad});
-      groups.erase(std::remove_if(groups.begin(), groups.end(),
-                                  [&](const Group& g) {
-                                    return g.Length() <
-                                           options.pass1_min_length_m;
-                                  }),
-                   groups.end());
-      groups =
-          MergeCollinear(result.points_2d, std::move(groups), direction,
-                         {options.pass2_max_gap_m, options.pass2_max_offset_m,
-                          options.pass2_max_angle_rad});
-      for (Group& g : groups) {
-        VLOG(3) << "  group length " << g.Length() << " rms " << g.rms_m;
-        if (g.Length() < options.min_long_side_length_m) continue;
-        LongSide side = FitLongSide(result.points, std::move(g.support), frame,
-                                    direction, set);
-        VLOG(2) << "long side " << result.sides.size() << ": set " << set
-                << " lateral " << side.lateral_m << " extent " << side.t_begin
-                << " " << side.t_end << " contrast " << side.contrast
-                << " points " << side.support.size();
-        result.sides.push_back(std::move(side));
-      }
+      ComponentSides(members, component, direction, set, frame, options,
+                     &result);
     }
   }
   return result;

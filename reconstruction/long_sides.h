@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "reconstruction/road_rectification.h"
+#include "reconstruction/road_plane.h"
 
 namespace zebrageo {
 
@@ -210,6 +210,10 @@ struct LongSideDetection {
 LongSide FitLongSide(const std::vector<EdgePoint3d>& points,
                      std::vector<int> support, const PlaneFrame& frame,
                      const Eigen::Vector2d& direction_2d, int direction_set);
+
+// Extent [low, high] of `side` along the plane-frame direction `along`.
+void SideExtent(const PlaneFrame& frame, const LongSide& side,
+                const Eigen::Vector2d& along, double* low, double* high);
 
 LongSideDetection DetectLongSides(const std::vector<EdgeChain3d>& chains,
                                   const PlaneFrame& frame,

@@ -40,43 +40,13 @@
 #include "reconstruction/long_sides.h"
 #include "reconstruction/road_plane.h"
 #include "reconstruction/road_rectification.h"
+#include "reconstruction/search_volume.h"
 #include "reconstruction/subpixel_edges.h"
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
-
-// The search volume of section 3.1: a slab around the road plane whose
-// half-thickness grows with the distance from the cameras (the tolerance
-// angle theta on the rig's attitude over the road).
-struct SearchVolumeOptions {
-  // Nominal road normal in the body frame, pointing down (body +z for a
-  // level vehicle). Only a starting point: the plane is estimated.
-  Eigen::Vector3d nominal_road_normal_body = Eigen::Vector3d::UnitZ();
-  // Nominal height of the cameras over the road along that normal, metres
-  // (roof-mounted mapping cameras: 2 to 3 m).
-  double nominal_camera_height_m = 2.3;
-  // Half-thickness of the slab while the plane is first estimated: covers
-  // the error of the nominal height.
-  double initial_slab_half_thickness_m = 1.0;
-  double initial_tolerance_angle_rad = 0.1;
-  // Exposures (spread over the survey) used for the first estimate.
-  int initialization_exposures = 8;
-  // Slab once the plane is known: half-thickness at the cameras, plus
-  // distance * tan(tolerance_angle_rad) (vehicle roll and pitch on its
-  // suspension, road camber).
-  double slab_half_thickness_m = 0.15;
-  double tolerance_angle_rad = 0.03;
-  // The running plane is the median of the last this-many per-pair fits.
-  int running_window = 15;
-  // Per-pair fits farther than this from the running plane (angle, offset)
-  // do not update it.
-  double max_plane_change_rad = 0.05;
-  double max_plane_change_m = 0.15;
-
-  std::string Check() const;
-};
 
 struct ReconstructionOptions {
   RectificationOptions rectification;

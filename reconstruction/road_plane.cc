@@ -7,6 +7,17 @@
 
 namespace zebrageo {
 
+bool RoadPlane::IntersectRay(const Eigen::Vector3d& origin,
+                             const Eigen::Vector3d& direction,
+                             Eigen::Vector3d* p_body) const {
+  const double denominator = normal_body.dot(direction);
+  if (std::abs(denominator) < 1e-12) return false;
+  const double t = (offset_m - normal_body.dot(origin)) / denominator;
+  if (!(t > 0.0)) return false;
+  *p_body = origin + t * direction;
+  return true;
+}
+
 std::string RoadPlaneOptions::Check() const {
   std::ostringstream error;
   if (!(ransac_tolerance_m > 0.0)) {

@@ -1,6 +1,7 @@
-// Robust road plane (Soheilian et al., section 4.2): RANSAC with a 20 cm
-// tolerance on the 3D edge points, then least squares on the points close
-// to it. Frames: body (FRD), metres; the normal points down (see RoadPlane).
+// The road plane (RoadPlane) and its robust estimate (Soheilian et al.,
+// section 4.2): RANSAC with a 20 cm tolerance on the 3D edge points, then
+// least squares on the points close to it. Frames: body (FRD), metres; the
+// normal points down (see RoadPlane).
 #ifndef ZEBRAGEO_RECONSTRUCTION_ROAD_PLANE_H_
 #define ZEBRAGEO_RECONSTRUCTION_ROAD_PLANE_H_
 
@@ -9,9 +10,29 @@
 #include <string>
 #include <vector>
 
-#include "reconstruction/road_rectification.h"
-
 namespace zebrageo {
+
+// The road plane in the body frame: points p with normal_body . p =
+// offset_m. `normal_body` is a unit vector pointing DOWN (into the road, body
+// +z for a level vehicle), so offset_m is the road's depth below the body
+// origin along the normal.
+struct RoadPlane {
+  Eigen::Vector3d normal_body = Eigen::Vector3d::UnitZ();
+  double offset_m = 0.0;
+
+  // Positive below the road, negative above (between road and cameras).
+  double SignedDistance(const Eigen::Vector3d& p_body) const {
+    return normal_body.dot(p_body) - offset_m;
+  }
+  // Orthogonal projection of a point onto the plane.
+  Eigen::Vector3d Project(const Eigen::Vector3d& p_body) const {
+    return p_body - SignedDistance(p_body) * normal_body;
+  }
+  // Intersection of the ray origin + t * direction (t > 0) with the plane.
+  bool IntersectRay(const Eigen::Vector3d& origin,
+                    const Eigen::Vector3d& direction,
+                    Eigen::Vector3d* p_body) const;
+};
 
 struct RoadPlaneOptions {
   // RANSAC inlier distance to the plane (the paper's 20 cm).

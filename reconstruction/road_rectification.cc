@@ -51,18 +51,51 @@ Eigen::Vector2d NormalizedFieldOfView(const Camera& camera) {
   return limit * 1.02;
 }
 
-}  // namespace
-
-bool RoadPlane::IntersectRay(const Eigen::Vector3d& origin,
-                             const Eigen::Vector3d& direction,
-                             Eigen::Vector3d* p_body) const {
-  const double denominator = normal_body.dot(direction);
-  if (std::abs(denominator) < 1e-12) return false;
-  const double t = (offset_m - normal_body.dot(origin)) / denominator;
-  if (!(t > 0.0)) return false;
-  *p_body = origin + t * direction;
-  return true;
+// Footprint of each camera on the road, in the left virtual camera's
+// normalised coordinates, within max_range_m of the left camera (nadir
+// `nadir_left`) and max_lateral_m across from `middle`; their common part
+// in `box`. False when they have none.
+bool CommonRoadFootprint(const RigCamera* const cameras[2],
+                         const Eigen::Vector3d centre_body[2],
+                         const Eigen::Matrix3d& R_body_virt,
+                         const RoadPlane& plane,
+                         const Eigen::Vector3d& nadir_left,
+                         const Eigen::Vector3d& middle,
+                         const RectificationOptions& options, Box* box_out) {
+  const Eigen::Vector3d x_axis = R_body_virt.col(0);
+  Box boxes[2];
+  for (int side = 0; side < 2; ++side) {
+    const Camera& camera = cameras[side]->camera;
+    const Eigen::Matrix3d R_body_cam = cameras[side]->T_body_cam.linear();
+    for (int v = 0; v < camera.height(); v += kFootprintStepPx) {
+      for (int u = 0; u < camera.width(); u += kFootprintStepPx) {
+        Eigen::Vector3d ray;
+        if (!camera.UnprojectToRay(Eigen::Vector2d(u, v), &ray)) continue;
+        Eigen::Vector3d p;
+        if (!plane.IntersectRay(centre_body[side], R_body_cam * ray, &p)) {
+          continue;
+        }
+        if ((p - nadir_left).norm() > options.max_range_m) continue;
+        if (std::abs((p - middle).dot(x_axis)) > options.max_lateral_m) {
+          continue;
+        }
+        const Eigen::Vector3d p_virt =
+            R_body_virt.transpose() * (p - centre_body[0]);
+        if (p_virt.z() <= 0.0) continue;
+        boxes[side].Add(p_virt.x() / p_virt.z(), p_virt.y() / p_virt.z());
+      }
+    }
+  }
+  Box box;
+  box.x_min = std::max(boxes[0].x_min, boxes[1].x_min);
+  box.y_min = std::max(boxes[0].y_min, boxes[1].y_min);
+  box.x_max = std::min(boxes[0].x_max, boxes[1].x_max);
+  box.y_max = std::min(boxes[0].y_max, boxes[1].y_max);
+  *box_out = box;
+  return !(boxes[0].Empty() || boxes[1].Empty() || box.Empty());
 }
+
+}  // namespace
 
 std::string RectificationOptions::Check() const {
   std::ostringstream error;
@@ -116,35 +149,9 @@ bool RoadRectification::Build(const RigCamera& left, const RigCamera& right,
 
   // Footprint of each camera on the road, in the left virtual camera's
   // normalised coordinates, within max_range_m of the left camera.
-  Box boxes[2];
-  for (int side = 0; side < 2; ++side) {
-    const Camera& camera = cameras[side]->camera;
-    const Eigen::Matrix3d R_body_cam = cameras[side]->T_body_cam.linear();
-    for (int v = 0; v < camera.height(); v += kFootprintStepPx) {
-      for (int u = 0; u < camera.width(); u += kFootprintStepPx) {
-        Eigen::Vector3d ray;
-        if (!camera.UnprojectToRay(Eigen::Vector2d(u, v), &ray)) continue;
-        Eigen::Vector3d p;
-        if (!plane.IntersectRay(centre_body_[side], R_body_cam * ray, &p)) {
-          continue;
-        }
-        if ((p - nadir_left).norm() > options.max_range_m) continue;
-        if (std::abs((p - middle).dot(x_axis)) > options.max_lateral_m) {
-          continue;
-        }
-        const Eigen::Vector3d p_virt =
-            R_body_virt_.transpose() * (p - centre_body_[0]);
-        if (p_virt.z() <= 0.0) continue;
-        boxes[side].Add(p_virt.x() / p_virt.z(), p_virt.y() / p_virt.z());
-      }
-    }
-  }
   Box box;
-  box.x_min = std::max(boxes[0].x_min, boxes[1].x_min);
-  box.y_min = std::max(boxes[0].y_min, boxes[1].y_min);
-  box.x_max = std::min(boxes[0].x_max, boxes[1].x_max);
-  box.y_max = std::min(boxes[0].y_max, boxes[1].y_max);
-  if (boxes[0].Empty() || boxes[1].Empty() || box.Empty()) {
+  if (!CommonRoadFootprint(cameras, centre_body_, R_body_virt_, plane,
+                           nadir_left, middle, options, &box)) {
     *error = "the two cameras see no common road area within max_range_m";
     return false;
   }
@@ -175,6 +182,16 @@ bool RoadRectification::Build(const RigCamera& left, const RigCamera& right,
   disparity_offset_px_ = focal_px_ * baseline_m_ / depth_centre;
 
   cv::Mat valid(height_, width_, CV_8U, cv::Scalar(255));
+  BuildRemapTables(cameras, options, &valid);
+  ClearBeyondRange(plane, nadir_left, middle, options, &valid);
+  valid_ = valid;
+  return true;
+}
+
+void RoadRectification::BuildRemapTables(const RigCamera* const cameras[2],
+                                         const RectificationOptions& options,
+                                         cv::Mat* valid_out) {
+  cv::Mat& valid = *valid_out;
   for (int side = 0; side < 2; ++side) {
     const Camera& camera = cameras[side]->camera;
     const Eigen::Matrix3d R_cam_virt =
@@ -212,7 +229,15 @@ bool RoadRectification::Build(const RigCamera& left, const RigCamera& right,
     }
     cv::convertMaps(map_x, map_y, map1_[side], map2_[side], CV_16SC2);
   }
-  // Range limit on the road.
+}
+
+void RoadRectification::ClearBeyondRange(const RoadPlane& plane,
+                                         const Eigen::Vector3d& nadir_left,
+                                         const Eigen::Vector3d& middle,
+                                         const RectificationOptions& options,
+                                         cv::Mat* valid_out) const {
+  cv::Mat& valid = *valid_out;
+  const Eigen::Vector3d x_axis = R_body_virt_.col(0);
   for (int y = 0; y < height_; ++y) {
     uint8_t* ok = valid.ptr<uint8_t>(y);
     for (int x = 0; x < width_; ++x) {
@@ -226,8 +251,6 @@ bool RoadRectification::Build(const RigCamera& left, const RigCamera& right,
       }
     }
   }
-  valid_ = valid;
-  return true;
 }
 
 void RoadRectification::Rectify(const cv::Mat& left_image,

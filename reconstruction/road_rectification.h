@@ -1,5 +1,5 @@
-// Road plane and "vertical" epipolar rectification of a stereo pair
-// (Soheilian et al., section 3.2).
+// "Vertical" epipolar rectification of a stereo pair over the road plane
+// (road_plane.h; Soheilian et al., section 3.2).
 //
 // Frames: body = FRD (x forward, y right, z down), metres. A virtual camera
 // ("virt") looks straight down at the road plane: its z axis is the road
@@ -25,31 +25,10 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "reconstruction/road_plane.h"
 #include "survey/rig.h"
 
 namespace zebrageo {
-
-// The road plane in the body frame: points p with normal_body . p =
-// offset_m. `normal_body` is a unit vector pointing DOWN (into the road, body
-// +z for a level vehicle), so offset_m is the road's depth below the body
-// origin along the normal.
-struct RoadPlane {
-  Eigen::Vector3d normal_body = Eigen::Vector3d::UnitZ();
-  double offset_m = 0.0;
-
-  // Positive below the road, negative above (between road and cameras).
-  double SignedDistance(const Eigen::Vector3d& p_body) const {
-    return normal_body.dot(p_body) - offset_m;
-  }
-  // Orthogonal projection of a point onto the plane.
-  Eigen::Vector3d Project(const Eigen::Vector3d& p_body) const {
-    return p_body - SignedDistance(p_body) * normal_body;
-  }
-  // Intersection of the ray origin + t * direction (t > 0) with the plane.
-  bool IntersectRay(const Eigen::Vector3d& origin,
-                    const Eigen::Vector3d& direction,
-                    Eigen::Vector3d* p_body) const;
-};
 
 struct RectificationOptions {
   // Ground sample distance of the rectified images on the road plane,
@@ -121,6 +100,19 @@ class RoadRectification {
   double DisparityOf(const Eigen::Vector3d& p_body) const;
 
  private:
+  // Build, after the geometry: the remap tables of both images, and
+  // `valid` (CV_8U, 255) cleared where a camera does not see (or sees
+  // within border_margin_px of its border).
+  void BuildRemapTables(const RigCamera* const cameras[2],
+                        const RectificationOptions& options, cv::Mat* valid);
+  // ... and cleared beyond max_range_m of the left camera's nadir or
+  // max_lateral_m across from `middle`, on the road plane.
+  void ClearBeyondRange(const RoadPlane& plane,
+                        const Eigen::Vector3d& nadir_left,
+                        const Eigen::Vector3d& middle,
+                        const RectificationOptions& options,
+                        cv::Mat* valid) const;
+
   int width_ = 0;
   int height_ = 0;
   double focal_px_ = 0.0;

@@ -97,45 +97,27 @@ cv::Vec2f EdgeMap::GradientAt(double x, double y) const {
   return cv::Vec2f(Bilinear(gx, x, y), Bilinear(gy, x, y));
 }
 
-EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
-                            const EdgeOptions& options) {
-  CHECK_EQ(image.type(), CV_32F);
-  EdgeMap edges;
-  edges.width = image.cols;
-  edges.height = image.rows;
-  cv::Mat smooth;
-  cv::GaussianBlur(image, smooth, cv::Size(0, 0), options.gaussian_sigma_px,
-                   options.gaussian_sigma_px, cv::BORDER_REPLICATE);
-  cv::Sobel(smooth, edges.gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0,
-            cv::BORDER_REPLICATE);
-  cv::Sobel(smooth, edges.gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0,
-            cv::BORDER_REPLICATE);
-  cv::Mat norm;
-  cv::magnitude(edges.gx, edges.gy, norm);
+namespace {
 
-  // Gradients within the smoothing support of an invalid pixel are
-  // artefacts of the border.
-  cv::Mat& usable = edges.usable;
-  if (!valid_mask.empty()) {
-    const int radius =
-        static_cast<int>(std::ceil(3.0 * options.gaussian_sigma_px)) + 1;
-    cv::erode(valid_mask, usable,
-              cv::getStructuringElement(
-                  cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
-  }
-
-  // Non-maximum suppression and Devernay's sub-pixel correction.
+// Non-maximum suppression and Devernay's sub-pixel correction of the
+// gradient `norm` of `edges`; `index` (CV_32S, -1 elsewhere) gets each
+// point's index.
+std::vector<EdgePoint> SuppressNonMaxima(const EdgeMap& edges,
+                                         const cv::Mat& norm,
+                                         const EdgeOptions& options,
+                                         cv::Mat* index_out) {
+  const cv::Mat& usable = edges.usable;
+  cv::Mat& index = *index_out;
   std::vector<EdgePoint> points;
-  cv::Mat index(image.rows, image.cols, CV_32S, cv::Scalar(-1));
   const float low = static_cast<float>(options.low_threshold);
-  for (int y = 1; y + 1 < image.rows; ++y) {
+  for (int y = 1; y + 1 < norm.rows; ++y) {
     const float* n0 = norm.ptr<float>(y - 1);
     const float* n1 = norm.ptr<float>(y);
     const float* n2 = norm.ptr<float>(y + 1);
     const float* gxr = edges.gx.ptr<float>(y);
     const float* gyr = edges.gy.ptr<float>(y);
     const uint8_t* ok = usable.empty() ? nullptr : usable.ptr<uint8_t>(y);
-    for (int x = 1; x + 1 < image.cols; ++x) {
+    for (int x = 1; x + 1 < norm.cols; ++x) {
       const float b = n1[x];
       if (b < low || (ok != nullptr && ok[x] == 0)) continue;
       float a, c;
@@ -163,8 +145,14 @@ EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
     }
   }
 
-  // Chaining: each point links to its closest forward neighbour; a point
-  // claimed by several keeps the closest predecessor.
+  return points;
+}
+
+// Chains of the points: each point links to its closest forward
+// neighbour; a point claimed by several keeps the closest predecessor.
+// Open chains from their first point, then closed contours.
+std::vector<std::vector<int>> LinkChains(const std::vector<EdgePoint>& points,
+                                         const cv::Mat& index) {
   const int n = static_cast<int>(points.size());
   std::vector<int> next(n, -1), prev(n, -1);
   for (int p = 0; p < n; ++p) next[p] = ForwardNeighbour(points, index, p);
@@ -200,7 +188,17 @@ EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
     if (!visited[p]) chains.push_back(follow(p));  // closed contours
   }
 
-  // Hysteresis per chain, then renumber points sorted by (row, x).
+  return chains;
+}
+
+// Hysteresis per chain: the chains of `points` long enough and with a
+// point above high_threshold go into `edges`, points renumbered sorted by
+// (row, x), with the rows' first points.
+void KeepChains(const std::vector<EdgePoint>& points,
+                const std::vector<std::vector<int>>& chains,
+                const EdgeOptions& options, int rows, EdgeMap* edges_out) {
+  EdgeMap& edges = *edges_out;
+  const int n = static_cast<int>(points.size());
   std::vector<int> chain_of(n, -1);
   std::vector<int> position_of(n, -1);
   int kept_chains = 0;
@@ -241,10 +239,47 @@ EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
       edges.points[edges.chains[c][i]].index_in_chain = static_cast<int>(i);
     }
   }
-  edges.row_begin.assign(image.rows + 1, 0);
+  edges.row_begin.assign(rows + 1, 0);
   for (const EdgePoint& e : edges.points) ++edges.row_begin[e.py + 1];
   std::partial_sum(edges.row_begin.begin(), edges.row_begin.end(),
                    edges.row_begin.begin());
+}
+
+}  // namespace
+
+EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
+                            const EdgeOptions& options) {
+  CHECK_EQ(image.type(), CV_32F);
+  EdgeMap edges;
+  edges.width = image.cols;
+  edges.height = image.rows;
+  cv::Mat smooth;
+  cv::GaussianBlur(image, smooth, cv::Size(0, 0), options.gaussian_sigma_px,
+                   options.gaussian_sigma_px, cv::BORDER_REPLICATE);
+  cv::Sobel(smooth, edges.gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0,
+            cv::BORDER_REPLICATE);
+  cv::Sobel(smooth, edges.gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0,
+            cv::BORDER_REPLICATE);
+  cv::Mat norm;
+  cv::magnitude(edges.gx, edges.gy, norm);
+
+  // Gradients within the smoothing support of an invalid pixel are
+  // artefacts of the border.
+  cv::Mat& usable = edges.usable;
+  if (!valid_mask.empty()) {
+    const int radius =
+        static_cast<int>(std::ceil(3.0 * options.gaussian_sigma_px)) + 1;
+    cv::erode(valid_mask, usable,
+              cv::getStructuringElement(
+                  cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  }
+
+  // Non-maximum suppression and Devernay's sub-pixel correction.
+  cv::Mat index(image.rows, image.cols, CV_32S, cv::Scalar(-1));
+  const std::vector<EdgePoint> points =
+      SuppressNonMaxima(edges, norm, options, &index);
+  const std::vector<std::vector<int>> chains = LinkChains(points, index);
+  KeepChains(points, chains, options, image.rows, &edges);
   return edges;
 }
 
