@@ -30,6 +30,7 @@ MatchResult RunSteps(const MatchInput& input, const MatchOptions& options,
   state.chosen.assign(n, -1);
   state.accepted.assign(n, false);
   state.ambiguous.assign(n, false);
+  state.unbeaten_offsets.assign(n, {});
   state.evidence.assign(n, ObservationEvidence());
   for (int o = 0; o < n; ++o) {
     const CrossingObservation& source = input.observations[o];
@@ -119,6 +120,7 @@ std::string MatchOptions::Check() const {
       !non_negative("max_drift_acceleration_m_per_s2",
                     max_drift_acceleration_m_per_s2) ||
       !non_negative("max_resolve_bound_m", max_resolve_bound_m) ||
+      !non_negative("max_exclusion_bound_m", max_exclusion_bound_m) ||
       !positive("max_sd_ratio", max_sd_ratio) ||
       !positive("shifted_crossing_threshold_m", shifted_crossing_threshold_m)) {
     return out.str();

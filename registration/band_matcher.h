@@ -185,6 +185,12 @@ struct MatchOptions {
   // bound grows by this per metre travelled from the nearest match.
   double max_drift_per_metre = 0.025;
   double max_resolve_bound_m = 0.4;
+  // An observation refused only because some band offsets of its crossing
+  // were beaten by band counts alone (min_strong_margin) is accepted when
+  // the prediction, with a bound up to this, lies within its bound of the
+  // observation's best and further than that from every such offset: the
+  // images ruled out the near offsets, continuity the far ones.
+  double max_exclusion_bound_m = 1.2;
   double max_sd_ratio = 2.0;
 
   // --- Database faults --------------------------------------------------

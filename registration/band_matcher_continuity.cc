@@ -234,7 +234,8 @@ bool UniqueNearPrediction(const MatchState& state, int o, int pick,
 }
 
 void AcceptResolved(int o, int pick, const Prediction& prediction,
-                    double pick_distance, MatchState* state) {
+                    double pick_distance, const std::string& how,
+                    MatchState* state) {
   const RoadmarkIndex& index = state->index;
   const std::vector<Hypothesis>& list = state->hypotheses[o];
   const bool interpolated = prediction.interpolated;
@@ -260,8 +261,35 @@ void AcceptResolved(int o, int pick, const Prediction& prediction,
   ev.reason = "resolved by trajectory continuity: the correction " +
               std::string(interpolated ? "interpolated" : "extrapolated") +
               " from matched exposures (" + Fixed(gap, 1) +
-              " s away; error bound " + Fixed(bound, 2) + " m) selects it at " +
-              Fixed(pick_distance, 2) + " m; alone it was " + was;
+              " s away; error bound " + Fixed(bound, 2) + " m) " + how +
+              " at " + Fixed(pick_distance, 2) + " m; alone it was " + was;
+}
+
+// True when the prediction, too loose to single out one hypothesis, still
+// rules out every band offset that the images' strong evidence left
+// standing against observation o's own best (which it must hold within
+// its bound): the images excluded the near offsets, continuity the far
+// ones. *distance: the own best's from the prediction.
+bool ExcludesUnbeatenOffsets(const MatchState& state, int o,
+                             const Prediction& prediction, double* distance) {
+  const MatchOptions& options = state.options;
+  const std::vector<int>& unbeaten = state.unbeaten_offsets[o];
+  const std::vector<Hypothesis>& list = state.hypotheses[o];
+  const Eigen::Vector2d& q = state.obs[o].centroid_q;
+  if (unbeaten.empty() || state.chosen[o] < 0 ||
+      prediction.bound_m > options.max_exclusion_bound_m) {
+    return false;
+  }
+  *distance = CorrectionDistance(list[state.chosen[o]].correction,
+                                 prediction.correction, q);
+  if (*distance > prediction.bound_m) return false;
+  for (int k : unbeaten) {
+    if (CorrectionDistance(list[k].correction, prediction.correction, q) <=
+        prediction.bound_m + options.same_correction_tolerance_m) {
+      return false;
+    }
+  }
+  return true;
 }
 
 // Resolves the observation at position k of by_time from its matched
@@ -281,6 +309,13 @@ void ResolveObservation(int k, MatchState* state) {
   const Prediction prediction = PredictCorrection(*state, o, before, after);
   const double bound = prediction.bound_m;
   if (bound > options.max_resolve_bound_m) {
+    double own_distance = 0.0;
+    if (ExcludesUnbeatenOffsets(*state, o, prediction, &own_distance)) {
+      AcceptResolved(o, state->chosen[o], prediction, own_distance,
+                     "rules out the band offsets the images left standing",
+                     state);
+      return;
+    }
     VLOG(1) << "resolve " << input.observations[o].exposure_id
             << ": prediction bound " << bound << " m too loose";
     return;
@@ -298,7 +333,7 @@ void ResolveObservation(int k, MatchState* state) {
             << ": several hypotheses near the prediction";
     return;
   }
-  AcceptResolved(o, pick, prediction, pick_distance, state);
+  AcceptResolved(o, pick, prediction, pick_distance, "selects it", state);
 }
 
 }  // namespace

@@ -114,6 +114,9 @@ struct Alternatives {
   // nothing before band 1), and which it is.
   double one_end_strong = std::numeric_limits<double>::infinity();
   int one_end_runner = -1;
+  // Every band offset of the same crossing beaten by less strong evidence
+  // than min_strong_margin.
+  std::vector<int> unbeaten;
 };
 Alternatives CompareAlternatives(const MatchState& state, int o, int best) {
   const MatchInput& input = state.input;
@@ -131,6 +134,7 @@ Alternatives CompareAlternatives(const MatchState& state, int o, int best) {
   double both_ends = std::numeric_limits<double>::infinity();
   double one_end_strong = std::numeric_limits<double>::infinity();
   int one_end_runner = -1;
+  std::vector<int> unbeaten;
   for (size_t k = 0; k < list.size(); ++k) {
     VLOG(3) << "hypothesis " << k << " of exposure "
             << input.observations[o].exposure_id << ": own "
@@ -156,8 +160,13 @@ Alternatives CompareAlternatives(const MatchState& state, int o, int best) {
       one_end_strong = m.strong;
       one_end_runner = static_cast<int>(k);
     }
+    if (list[k].main_crossing == h.main_crossing &&
+        m.strong < options.min_strong_margin) {
+      unbeaten.push_back(static_cast<int>(k));
+    }
   }
-  return {runner, margin, both_ends, one_end_strong, one_end_runner};
+  return {runner,         margin,         both_ends,
+          one_end_strong, one_end_runner, std::move(unbeaten)};
 }
 
 // The reason of an accepted observation.
@@ -207,8 +216,8 @@ void DecideAlone(int o, MatchState* state) {
   if (h.main_crossing >= 0) {
     ev.crossing_id = index.crossings()[h.main_crossing].crossing_id;
   }
-  const auto [runner, margin, both_ends, one_end_strong, one_end_runner] =
-      CompareAlternatives(*state, o, best);
+  const auto [runner, margin, both_ends, one_end_strong, one_end_runner,
+              unbeaten] = CompareAlternatives(*state, o, best);
   if (runner >= 0) {
     const Hypothesis& r = list[runner];
     ev.has_runner_up = true;
@@ -252,6 +261,7 @@ void DecideAlone(int o, MatchState* state) {
   }
   if (one_end_runner >= 0 && one_end_strong < options.min_strong_margin) {
     state->ambiguous[o] = true;
+    state->unbeaten_offsets[o] = unbeaten;
     ev.reason = "ambiguous: decided against " +
                 DescribeAlternative(index, obs, h, list[one_end_runner]) +
                 " by band counts alone (evidence a database missing an "

@@ -235,6 +235,10 @@ struct MatchState {
   std::vector<int> chosen;           // hypothesis index or -1
   std::vector<bool> accepted;
   std::vector<bool> ambiguous;
+  // Per observation refused by min_strong_margin alone: the band offsets
+  // of its crossing that no strong evidence beat (continuity may rule them
+  // out although it cannot single out one hypothesis among all).
+  std::vector<std::vector<int>> unbeaten_offsets;
   std::set<int> inconsistent;  // refused by the continuity check
   std::vector<ObservationEvidence> evidence;
   std::vector<VertexMatch> matches;

@@ -15,6 +15,7 @@
 
 #include "survey/image_io.h"
 #include "survey/math_util.h"
+#include "tiepoints/stereo_odometry.h"
 
 namespace zebrageo {
 namespace {
@@ -27,7 +28,16 @@ struct ImageFeatures {
   cv::Mat descriptors;
   std::vector<Eigen::Vector2d> normalized;  // undistorted x/z, y/z
   std::vector<char> has_normalized;
+  // The pose the geometric checks use: the trajectory's, with the camera's
+  // motion between exposures measured from the images where they could
+  // (stereo_odometry.h); it agrees with the trajectory's locally, not
+  // globally.
   Eigen::Isometry3d T_enu_cam = Eigen::Isometry3d::Identity();
+  // The trajectory's pose (tracks are expressed in its frame).
+  Eigen::Isometry3d T_enu_cam_ins = Eigen::Isometry3d::Identity();
+  // Keypoints triangulated by this image's stereo pair (camera frame).
+  std::vector<Eigen::Vector3d> point_cam;
+  std::vector<char> has_point;
 };
 
 // Union-find over (image, keypoint) nodes.
@@ -94,7 +104,10 @@ class FeatureGraph {
         node_offset_(exposures.images.size(), 0),
         orb_(cv::ORB::create(options.max_features_per_image, kOrbScaleFactor,
                              options.orb_levels)),
-        matcher_(cv::NORM_HAMMING) {
+        matcher_(cv::NORM_HAMMING),
+        T_enu_body_ins_(exposures.exposures.size()),
+        T_enu_body_checked_(exposures.exposures.size()),
+        has_checked_pose_(exposures.exposures.size(), 0) {
     for (int e = 0; e < static_cast<int>(exposures.exposures.size()); ++e) {
       exposure_index_[exposures.exposures[e].exposure_id] = e;
     }
@@ -107,10 +120,30 @@ class FeatureGraph {
   // The components that make a track, in the order of their roots.
   std::vector<Candidate> Candidates(Rejections* rejected);
 
+  // Exposure steps whose motion the images measured, of all steps, and
+  // how far the trajectory's motion departed from it (metres).
+  int motions_measured() const { return motions_measured_; }
+  int motion_steps() const { return motion_steps_; }
+  const std::vector<double>& motion_departures_m() const {
+    return motion_departures_m_;
+  }
+
  private:
   void Load(int image_index);
   void RefineSubpixel(const cv::Mat& grey, ImageFeatures* f) const;
-  void Match(int a, int b);
+  // Keypoint pairs of images a and b that pass the descriptor ratio test.
+  std::vector<std::pair<int, int>> Putative(int a, int b);
+  // Joins the putative pairs that the epipolar geometry of the two images'
+  // checked poses accepts; returns them.
+  std::vector<std::pair<int, int>> Match(int a, int b);
+  // Stereo points of image a from its matches with image b of the same
+  // exposure (the rig's calibration, no trajectory).
+  void TriangulateStereo(int a, int b,
+                         const std::vector<std::pair<int, int>>& pairs);
+  // Exposure e's checked poses: the previous exposure's, moved by the
+  // camera's motion measured from the images, or the trajectory's motion
+  // where they could not measure it.
+  void SetCheckedPoses(int e);
   // Midpoint triangulation of the nodes' rays; false when not finite.
   bool Triangulate(const std::vector<int>& nodes, Eigen::Vector3d* X,
                    double* max_angle) const;
@@ -133,6 +166,13 @@ class FeatureGraph {
   std::map<int64_t, int> exposure_index_;
   cv::Ptr<cv::ORB> orb_;
   cv::BFMatcher matcher_;
+  const StereoOdometryOptions odometry_;
+  std::vector<Eigen::Isometry3d> T_enu_body_ins_;
+  std::vector<Eigen::Isometry3d> T_enu_body_checked_;
+  std::vector<char> has_checked_pose_;
+  int motions_measured_ = 0;
+  int motion_steps_ = 0;
+  std::vector<double> motion_departures_m_;
 };
 
 void FeatureGraph::Load(int image_index) {
@@ -168,6 +208,9 @@ void FeatureGraph::Load(int image_index) {
     f.has_normalized[k] = camera.UnprojectToNormalized(uv, &f.normalized[k]);
   }
   f.T_enu_cam = pose.T_enu_body() * rig_.cameras[image.camera].T_body_cam;
+  f.T_enu_cam_ins = f.T_enu_cam;
+  f.point_cam.resize(f.keypoints.size());
+  f.has_point.assign(f.keypoints.size(), 0);
   f.valid = !f.keypoints.empty();
   node_offset_[image_index] = static_cast<int>(node_key_.size());
   for (size_t k = 0; k < f.keypoints.size(); ++k) {
@@ -191,13 +234,16 @@ void FeatureGraph::RefineSubpixel(const cv::Mat& grey, ImageFeatures* f) const {
   }
 }
 
-void FeatureGraph::Match(int a, int b) {
+std::vector<std::pair<int, int>> FeatureGraph::Putative(int a, int b) {
+  std::vector<std::pair<int, int>> pairs;
   const ImageFeatures& fa = features_[a];
   const ImageFeatures& fb = features_[b];
-  if (!fa.valid || !fb.valid) return;
+  if (!fa.valid || !fb.valid || fa.descriptors.empty() ||
+      fb.descriptors.empty()) {
+    return pairs;
+  }
   std::vector<std::vector<cv::DMatch>> knn;
   matcher_.knnMatch(fa.descriptors, fb.descriptors, knn, 2);
-  const double focal = rig_.cameras[exposures_.images[b].camera].camera.fx();
   for (const auto& m : knn) {
     if (m.size() < 2 ||
         m[0].distance > options_.max_descriptor_ratio * m[1].distance) {
@@ -205,12 +251,111 @@ void FeatureGraph::Match(int a, int b) {
     }
     const int ka = m[0].queryIdx, kb = m[0].trainIdx;
     if (!fa.has_normalized[ka] || !fb.has_normalized[kb]) continue;
+    pairs.emplace_back(ka, kb);
+  }
+  return pairs;
+}
+
+std::vector<std::pair<int, int>> FeatureGraph::Match(int a, int b) {
+  std::vector<std::pair<int, int>> kept;
+  const ImageFeatures& fa = features_[a];
+  const ImageFeatures& fb = features_[b];
+  const double focal = rig_.cameras[exposures_.images[b].camera].camera.fx();
+  for (const auto& [ka, kb] : Putative(a, b)) {
     if (EpipolarDistancePx(fa, fb, fa.normalized[ka], fb.normalized[kb],
                            focal) > options_.max_epipolar_distance_px) {
       continue;
     }
     sets_.Union(node_offset_[a] + ka, node_offset_[b] + kb);
     ++summary_->matches;
+    kept.emplace_back(ka, kb);
+  }
+  return kept;
+}
+
+void FeatureGraph::TriangulateStereo(
+    int a, int b, const std::vector<std::pair<int, int>>& pairs) {
+  ImageFeatures& fa = features_[a];
+  const ImageFeatures& fb = features_[b];
+  const Eigen::Isometry3d T_cb_ca =
+      rig_.cameras[exposures_.images[b].camera].T_body_cam.inverse() *
+      rig_.cameras[exposures_.images[a].camera].T_body_cam;
+  const double focal = rig_.cameras[exposures_.images[a].camera].camera.fx();
+  for (const auto& [ka, kb] : pairs) {
+    fa.has_point[ka] =
+        TriangulateStereoPoint(odometry_, T_cb_ca, fa.normalized[ka],
+                               fb.normalized[kb], focal, &fa.point_cam[ka]);
+  }
+}
+
+void FeatureGraph::SetCheckedPoses(int e) {
+  const Exposure& exposure = exposures_.exposures[e];
+  int first = -1;  // an image with a pose gives the trajectory's body pose
+  for (int image : exposure.image_of_camera) {
+    if (image >= 0 && features_[image].valid) {
+      first = image;
+      break;
+    }
+  }
+  if (first < 0) return;
+  T_enu_body_ins_[e] =
+      features_[first].T_enu_cam_ins *
+      rig_.cameras[exposures_.images[first].camera].T_body_cam.inverse();
+  T_enu_body_checked_[e] = T_enu_body_ins_[e];
+  has_checked_pose_[e] = 1;
+  if (e > 0 && has_checked_pose_[e - 1]) {
+    // The step from the previous exposure: the trajectory's, replaced by
+    // the images' where a stereo pair measured it (the most inliers).
+    const Exposure& previous = exposures_.exposures[e - 1];
+    Eigen::Isometry3d T_prev_body =
+        T_enu_body_ins_[e - 1].inverse() * T_enu_body_ins_[e];
+    CameraMotion best;
+    int best_camera = -1;
+    for (const auto& pair : rig_.stereo_pairs) {
+      const int a = previous.image_of_camera[pair[0]];
+      const int b = exposure.image_of_camera[pair[0]];
+      if (a < 0 || b < 0 || !features_[a].valid || !features_[b].valid) {
+        continue;
+      }
+      std::vector<Eigen::Vector3d> points_ca;
+      std::vector<Eigen::Vector2d> x_b;
+      for (const auto& [ka, kb] : Putative(a, b)) {
+        if (!features_[a].has_point[ka]) continue;
+        points_ca.push_back(features_[a].point_cam[ka]);
+        x_b.push_back(features_[b].normalized[kb]);
+      }
+      const CameraMotion motion = CameraMotionFromStereoPoints(
+          odometry_, points_ca, x_b,
+          features_[b].T_enu_cam_ins.inverse() * features_[a].T_enu_cam_ins,
+          rig_.cameras[pair[0]].camera.fx());
+      VLOG(2) << "tie points: camera motion at exposure " << e << ": "
+              << motion.correspondences << " stereo points seen again, "
+              << motion.inliers << " inliers, accepted " << motion.valid;
+      if (motion.valid && motion.inliers > best.inliers) {
+        best = motion;
+        best_camera = pair[0];
+      }
+    }
+    ++motion_steps_;
+    if (best_camera >= 0) {
+      const Eigen::Isometry3d& T_body_cam =
+          rig_.cameras[best_camera].T_body_cam;
+      const Eigen::Isometry3d T_prev_body_images =
+          T_body_cam * best.T_cb_ca.inverse() * T_body_cam.inverse();
+      motion_departures_m_.push_back(
+          (T_prev_body_images.translation() - T_prev_body.translation())
+              .norm());
+      T_prev_body = T_prev_body_images;
+      ++motions_measured_;
+    }
+    T_enu_body_checked_[e] = T_enu_body_checked_[e - 1] * T_prev_body;
+  }
+  for (size_t c = 0; c < rig_.cameras.size(); ++c) {
+    const int image = exposure.image_of_camera[c];
+    if (image >= 0 && features_[image].valid) {
+      features_[image].T_enu_cam =
+          T_enu_body_checked_[e] * rig_.cameras[c].T_body_cam;
+    }
   }
 }
 
@@ -226,8 +371,9 @@ void FeatureGraph::MatchExposures(
     for (const auto& pair : rig_.stereo_pairs) {
       const int a = exposure.image_of_camera[pair[0]];
       const int b = exposure.image_of_camera[pair[1]];
-      if (a >= 0 && b >= 0) Match(a, b);
+      if (a >= 0 && b >= 0) TriangulateStereo(a, b, Match(a, b));
     }
+    SetCheckedPoses(e);
     for (int back = 1; back <= window && e - back >= 0; ++back) {
       const Exposure& previous = exposures_.exposures[e - back];
       for (size_t c = 0; c < rig_.cameras.size(); ++c) {
@@ -325,7 +471,11 @@ bool FeatureGraph::MakeCandidate(const std::vector<int>& nodes,
          std::pow(kOrbScaleFactor, f.keypoints[k].octave)});
     candidate->exposures.push_back(exposure_index_[info.exposure_id]);
   }
-  candidate->track.p_enu = X;
+  // X is in the checked poses' frame, which agrees with the trajectory's
+  // only locally: carried over through the track's first image.
+  const ImageFeatures& first = features_[node_key_[nodes.front()].first];
+  candidate->track.p_enu =
+      first.T_enu_cam_ins * (first.T_enu_cam.inverse() * X);
   std::vector<int>& tied = candidate->exposures;
   std::sort(tied.begin(), tied.end());
   tied.erase(std::unique(tied.begin(), tied.end()), tied.end());
@@ -447,6 +597,13 @@ std::vector<TieTrack> BuildTieTracks(
   summary->time_in_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
+  if (!graph.motion_departures_m().empty()) {
+    LOG(INFO) << "tie points: the camera's motion measured from the images "
+              << "for " << graph.motions_measured() << " of "
+              << graph.motion_steps()
+              << " exposure steps; the trajectory's departs from it by "
+              << Median(graph.motion_departures_m()) * 100.0 << " cm (median)";
+  }
   LOG(INFO) << "tie points: " << summary->tracks << " tracks, "
             << summary->observations << " observations from "
             << summary->images_read << " images in " << summary->time_in_seconds
