@@ -30,6 +30,9 @@ std::string StereoOdometryOptions::Check() const {
     message << "max_stereo_error_px and max_pnp_error_px must be > 0";
   } else if (min_inliers < 6) {
     message << "min_inliers = " << min_inliers << ": must be >= 6";
+  } else if (!(max_descriptor_ratio > 0.0 && max_descriptor_ratio <= 1.0)) {
+    message << "max_descriptor_ratio = " << max_descriptor_ratio
+            << ": must be in (0, 1]";
   } else if (!(min_inlier_share >= 0.0 && min_inlier_share <= 1.0)) {
     message << "min_inlier_share = " << min_inlier_share
             << ": must be in [0, 1]";
@@ -87,19 +90,29 @@ CameraMotion CameraMotionFromStereoPoints(
     object.emplace_back(points_ca[i].x(), points_ca[i].y(), points_ca[i].z());
     image.emplace_back(x_b[i].x(), x_b[i].y());
   }
-  cv::Mat R_prior, rvec, tvec;
-  cv::eigen2cv(Eigen::Matrix3d(T_cb_ca_prior.linear()), R_prior);
-  cv::Rodrigues(R_prior, rvec);
-  cv::eigen2cv(Eigen::Vector3d(T_cb_ca_prior.translation()), tvec);
+  cv::Mat rvec, tvec;
   std::vector<int> inliers;
   // Normalised coordinates: the camera matrix is the identity and the
   // threshold is in focal lengths. OpenCV's RANSAC draws from a fixed seed,
   // so the result is deterministic.
-  const bool solved = cv::solvePnPRansac(
-      object, image, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec,
-      /*useExtrinsicGuess=*/true, /*iterationsCount=*/200,
+  // Minimal samples by AP3P: with the iterative kernel started from the
+  // prior, a quarter of mismatches sent OpenCV's RANSAC to a wrong pose.
+  // Then refined on the inliers, Levenberg-Marquardt from that pose.
+  const cv::Mat K = cv::Mat::eye(3, 3, CV_64F);
+  bool solved = cv::solvePnPRansac(
+      object, image, K, cv::noArray(), rvec, tvec,
+      /*useExtrinsicGuess=*/false, /*iterationsCount=*/300,
       static_cast<float>(options.max_pnp_error_px / focal_px),
-      /*confidence=*/0.999, inliers, cv::SOLVEPNP_ITERATIVE);
+      /*confidence=*/0.999, inliers, cv::SOLVEPNP_AP3P);
+  if (!solved || static_cast<int>(inliers.size()) < 4) return motion;
+  std::vector<cv::Point3d> object_in;
+  std::vector<cv::Point2d> image_in;
+  for (int i : inliers) {
+    object_in.push_back(object[i]);
+    image_in.push_back(image[i]);
+  }
+  solved = cv::solvePnP(object_in, image_in, K, cv::noArray(), rvec, tvec,
+                        /*useExtrinsicGuess=*/true, cv::SOLVEPNP_ITERATIVE);
   if (!solved) return motion;
   cv::Mat R;
   cv::Rodrigues(rvec, R);

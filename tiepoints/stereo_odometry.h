@@ -25,6 +25,9 @@
 namespace zebrageo {
 
 struct StereoOdometryOptions {
+  // Lowe's ratio for the correspondences between exposures: looser than
+  // the tie points' own, since PnP with RANSAC verifies them.
+  double max_descriptor_ratio = 0.9;
   // Stereo points are used out to this range (metres): the depth error
   // grows with the square of the range.
   double max_range_m = 25.0;
@@ -34,7 +37,7 @@ struct StereoOdometryOptions {
   double max_pnp_error_px = 1.5;
   // A motion is accepted with at least this many PnP inliers, and at least
   // this share of the putative correspondences.
-  int min_inliers = 10;
+  int min_inliers = 8;
   double min_inlier_share = 0.3;
   // The measured motion may depart from the trajectory's by at most this
   // much (metres; radians): beyond, the images were misread (a repeated
@@ -65,7 +68,7 @@ struct CameraMotion {
 
 // The motion of a camera from exposure a to exposure b: points_ca (stereo
 // points of exposure a) seen at normalised coordinates x_b in exposure b.
-// T_cb_ca_prior (the trajectory's) starts the solve and bounds the result.
+// T_cb_ca_prior (the trajectory's) bounds the result.
 CameraMotion CameraMotionFromStereoPoints(
     const StereoOdometryOptions& options,
     const std::vector<Eigen::Vector3d>& points_ca,

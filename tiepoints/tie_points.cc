@@ -132,7 +132,8 @@ class FeatureGraph {
   void Load(int image_index);
   void RefineSubpixel(const cv::Mat& grey, ImageFeatures* f) const;
   // Keypoint pairs of images a and b that pass the descriptor ratio test.
-  std::vector<std::pair<int, int>> Putative(int a, int b);
+  // (`ratio`: Lowe's ratio, the options' when negative).
+  std::vector<std::pair<int, int>> Putative(int a, int b, double ratio = -1.0);
   // Joins the putative pairs that the epipolar geometry of the two images'
   // checked poses accepts; returns them.
   std::vector<std::pair<int, int>> Match(int a, int b);
@@ -234,7 +235,9 @@ void FeatureGraph::RefineSubpixel(const cv::Mat& grey, ImageFeatures* f) const {
   }
 }
 
-std::vector<std::pair<int, int>> FeatureGraph::Putative(int a, int b) {
+std::vector<std::pair<int, int>> FeatureGraph::Putative(int a, int b,
+                                                        double ratio) {
+  if (ratio < 0.0) ratio = options_.max_descriptor_ratio;
   std::vector<std::pair<int, int>> pairs;
   const ImageFeatures& fa = features_[a];
   const ImageFeatures& fb = features_[b];
@@ -245,8 +248,7 @@ std::vector<std::pair<int, int>> FeatureGraph::Putative(int a, int b) {
   std::vector<std::vector<cv::DMatch>> knn;
   matcher_.knnMatch(fa.descriptors, fb.descriptors, knn, 2);
   for (const auto& m : knn) {
-    if (m.size() < 2 ||
-        m[0].distance > options_.max_descriptor_ratio * m[1].distance) {
+    if (m.size() < 2 || m[0].distance > ratio * m[1].distance) {
       continue;
     }
     const int ka = m[0].queryIdx, kb = m[0].trainIdx;
@@ -319,7 +321,9 @@ void FeatureGraph::SetCheckedPoses(int e) {
       }
       std::vector<Eigen::Vector3d> points_ca;
       std::vector<Eigen::Vector2d> x_b;
-      for (const auto& [ka, kb] : Putative(a, b)) {
+      // A looser ratio test: PnP with RANSAC verifies these.
+      for (const auto& [ka, kb] :
+           Putative(a, b, odometry_.max_descriptor_ratio)) {
         if (!features_[a].has_point[ka]) continue;
         points_ca.push_back(features_[a].point_cam[ka]);
         x_b.push_back(features_[b].normalized[kb]);
