@@ -9,6 +9,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "geodata/gps_time.h"
 #include "survey/crs.h"
@@ -185,7 +186,9 @@ std::string ParseColumnMap(const std::string& text,
 std::vector<TrajectorySample> ReadTrajectoryCsv(
     const std::string& path, const CsvTrajectoryFormat& format) {
   const std::string error = format.Check();
-  CHECK(error.empty()) << error;
+  if (!error.empty()) {
+    throw std::invalid_argument("CsvTrajectoryFormat: " + error);
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, 0, "cannot read the trajectory file");
   std::ostringstream text;

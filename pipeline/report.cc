@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <tuple>
 
 #include "pipeline/report_data.h"
@@ -379,7 +380,7 @@ std::string RenderReportHtml(const json& report, const ReportInputs& inputs) {
 json WriteReport(const ReportInputs& inputs, const ReportOptions& options) {
   CHECK(inputs.survey != nullptr);
   const std::string error = options.Check();
-  CHECK(error.empty()) << error;
+  if (!error.empty()) throw std::invalid_argument("ReportOptions: " + error);
   const ReportData data = Collect(inputs);
   const json report = BuildFromData(inputs, options, data);
   const std::string html = RenderHtml(report, data);

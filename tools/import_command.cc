@@ -97,6 +97,8 @@ CsvTrajectoryFormat CsvFormatOf(const TrajectoryArguments& args) {
     const std::string error = ParseColumnMap(args.columns, &format);
     if (!error.empty()) throw UsageError("--columns: " + error);
   }
+  const std::string problem = format.Check();
+  if (!problem.empty()) throw UsageError("import-trajectory: " + problem);
   return format;
 }
 

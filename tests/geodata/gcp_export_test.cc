@@ -58,7 +58,10 @@ class GcpExport : public ::testing::Test {
     ASSERT_FALSE(rows.empty());
     const std::string check_crossing = rows.front().crossing_id;
     for (GcpResidual& r : rows) {
-      if (r.crossing_id == check_crossing) r.role = GcpRole::kCheck;
+      if (r.crossing_id == check_crossing) {
+        r.role = GcpRole::kCheck;      // a check crossing, as the adjustment
+        r.status = GcpStatus::kCheck;  // writes it: role and status check
+      }
     }
     WriteGcpResiduals(rows, residuals);
   }
