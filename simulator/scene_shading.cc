@@ -44,6 +44,55 @@ float PaintTone(double x, double y, double footprint_m, uint64_t salt) {
 }
 }  // namespace
 
+// The paint of the bands of crossing `index` near the ground point *p: the
+// ray's exact hit on a band's planar quad (before t_box) replaces *p, *value
+// and *key.
+void ImageScene::ShadeBandPaint(const Eigen::Vector3d& d, double t_box,
+                                double footprint, int index, Eigen::Vector3d* p,
+                                float* value, uint32_t* key) const {
+  const uint64_t salt = world_.texture_salt;
+  const Crossing& c = world_.crossings[index];
+  const Eigen::Vector2d rel = p->head<2>() - c.origin_xy;
+  const double o = rel.dot(c.n);
+  const int nearest =
+      static_cast<int>(std::floor((o - c.first_offset_m) / c.band_period_m)) +
+      1;
+  for (int b = std::max(1, nearest - 1);
+       b <= std::min(c.num_street_bands, nearest + 1); ++b) {
+    const Band& band = world_.bands[first_band_[index] + b - 1];
+    if (o < band.o0 - 0.3 || o > band.o1 + 0.3) continue;
+    // Exact intersection with the band's planar quad.
+    const double denominator = band.plane_normal.dot(d);
+    if (std::abs(denominator) < 1e-9) continue;
+    const double tp =
+        (band.plane_offset - band.plane_normal.dot(C_)) / denominator;
+    if (tp <= 0.0 || tp >= t_box) continue;
+    const Eigen::Vector3d q = C_ + tp * d;
+    const Eigen::Vector2d rq = q.head<2>() - c.origin_xy;
+    const double oq = rq.dot(c.n);
+    const double aq = rq.dot(c.t) - oq * c.tan_skew;
+    if (oq < band.o0 || oq > band.o1 || std::abs(aq) > 0.5 * c.band_length_m) {
+      continue;
+    }
+    float alpha = PaintAlpha(q.x(), q.y(), world_.paint_wear, band.salt);
+    if (band.patch_radius_m > 0.0) {
+      const double r = (Eigen::Vector2d(aq, oq) - band.patch_ao).norm();
+      const double edge =
+          band.patch_radius_m *
+          (0.7 + 0.6 * ValueNoise(q.x() / 0.15, q.y() / 0.15, band.salt + 3));
+      alpha *= static_cast<float>(
+          1.0 - 0.88 * (1.0 - SmoothStep(edge - 0.04, edge, r)));
+    }
+    const float under =
+        kAsphaltTone * AsphaltTexture(q.x(), q.y(), footprint, salt);
+    *value = under * (1.0f - alpha) +
+             alpha * PaintTone(q.x(), q.y(), footprint, band.salt);
+    *key = Key(kBandPaint, first_band_[index] + b);
+    *p = q;
+    return;
+  }
+}
+
 Sample ImageScene::ShadeGround(const Eigen::Vector3d& d, double t,
                                const GroundPoint& g, double t_box) const {
   Eigen::Vector3d p = C_ + t * d;
@@ -112,48 +161,7 @@ Sample ImageScene::ShadeGround(const Eigen::Vector3d& d, double t,
       const uint32_t type = item >> 24;
       const int index = static_cast<int>(item & 0xffffff);
       if (type == kItemCrossing) {
-        const Crossing& c = world_.crossings[index];
-        const Eigen::Vector2d rel = p.head<2>() - c.origin_xy;
-        const double o = rel.dot(c.n);
-        const int nearest = static_cast<int>(std::floor((o - c.first_offset_m) /
-                                                        c.band_period_m)) +
-                            1;
-        for (int b = std::max(1, nearest - 1);
-             b <= std::min(c.num_street_bands, nearest + 1); ++b) {
-          const Band& band = world_.bands[first_band_[index] + b - 1];
-          if (o < band.o0 - 0.3 || o > band.o1 + 0.3) continue;
-          // Exact intersection with the band's planar quad.
-          const double denominator = band.plane_normal.dot(d);
-          if (std::abs(denominator) < 1e-9) continue;
-          const double tp =
-              (band.plane_offset - band.plane_normal.dot(C_)) / denominator;
-          if (tp <= 0.0 || tp >= t_box) continue;
-          const Eigen::Vector3d q = C_ + tp * d;
-          const Eigen::Vector2d rq = q.head<2>() - c.origin_xy;
-          const double oq = rq.dot(c.n);
-          const double aq = rq.dot(c.t) - oq * c.tan_skew;
-          if (oq < band.o0 || oq > band.o1 ||
-              std::abs(aq) > 0.5 * c.band_length_m) {
-            continue;
-          }
-          float alpha = PaintAlpha(q.x(), q.y(), world_.paint_wear, band.salt);
-          if (band.patch_radius_m > 0.0) {
-            const double r = (Eigen::Vector2d(aq, oq) - band.patch_ao).norm();
-            const double edge =
-                band.patch_radius_m *
-                (0.7 +
-                 0.6 * ValueNoise(q.x() / 0.15, q.y() / 0.15, band.salt + 3));
-            alpha *= static_cast<float>(
-                1.0 - 0.88 * (1.0 - SmoothStep(edge - 0.04, edge, r)));
-          }
-          const float under =
-              kAsphaltTone * AsphaltTexture(q.x(), q.y(), footprint, salt);
-          value = under * (1.0f - alpha) +
-                  alpha * PaintTone(q.x(), q.y(), footprint, band.salt);
-          key = Key(kBandPaint, first_band_[index] + b);
-          p = q;
-          break;
-        }
+        ShadeBandPaint(d, t_box, footprint, index, &p, &value, &key);
       } else if (type == kItemManhole) {
         const Manhole& m = world_.manholes[index];
         const Eigen::Vector2d rel = p.head<2>() - m.centre;
