@@ -10,9 +10,24 @@
 #include <random>
 
 #include "simulator/noise.h"
+#include "simulator/world_internal.h"
 #include "survey/math_util.h"
 
 namespace zebrageo::sim {
+
+using world_internal::BuildFacades;
+using world_internal::CastShadows;
+using world_internal::kCrossingSeed;
+using world_internal::kDatabaseSeed;
+using world_internal::kMarksSeed;
+using world_internal::kRoadSeed;
+using world_internal::kTextureSeed;
+using world_internal::NearCrossing;
+using world_internal::ParkOverEndBands;
+using world_internal::ParkVehicles;
+using world_internal::StopLineBefore;
+using world_internal::Subtract;
+
 namespace {
 
 constexpr double kDegToRad = kPi / 180.0;
@@ -25,77 +40,10 @@ constexpr double kBandKerbMarginM = 0.25;
 // Offset of the edge lines from the kerbs.
 constexpr double kEdgeLineInsetM = 0.3;
 
-// Purposes of the sub-generators (SubSeed).
-enum Purpose : uint64_t {
-  kRoadSeed = 1,
-  kCrossingSeed = 2,
-  kMarksSeed = 3,
-  kDatabaseSeed = 4,
-  kBuildingSeed = 5,
-  kVehicleSeed = 6,
-  kTextureSeed = 9,
-};
-
-std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> points) {
-  std::sort(points.begin(), points.end(),
-            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-              return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-            });
-  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a,
-                  const Eigen::Vector2d& b) {
-    return (a.x() - o.x()) * (b.y() - o.y()) -
-           (a.y() - o.y()) * (b.x() - o.x());
-  };
-  std::vector<Eigen::Vector2d> hull(2 * points.size());
-  size_t k = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
-    hull[k++] = points[i];
-  }
-  for (size_t i = points.size() - 1, t = k + 1; i > 0; --i) {
-    while (k >= t && cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
-    hull[k++] = points[i - 1];
-  }
-  hull.resize(k - 1);
-  return hull;
-}
-
-Shadow CastShadow(const VerticalBox& box, double ground_z,
-                  const Eigen::Vector3d& sun, float factor) {
-  const double height = box.z1 - ground_z;
-  const Eigen::Vector2d offset =
-      -height * Eigen::Vector2d(sun.x(), sun.y()) / sun.z();
-  std::vector<Eigen::Vector2d> points;
-  for (const Eigen::Vector2d& p : box.Footprint()) {
-    points.push_back(p);
-    points.push_back(p + offset);
-  }
-  Shadow shadow;
-  shadow.polygon = ConvexHull(points);
-  shadow.factor = factor;
-  return shadow;
-}
-
 std::string CrossingId(int number) {
   char text[32];
   std::snprintf(text, sizeof(text), "zc-%04d", number);
   return text;
-}
-
-// The s-intervals of [s0, s1] left after removing `holes` (sorted, merged).
-std::vector<std::pair<double, double>> Subtract(
-    double s0, double s1, std::vector<std::pair<double, double>> holes) {
-  std::sort(holes.begin(), holes.end());
-  std::vector<std::pair<double, double>> out;
-  double start = s0;
-  for (const auto& [a, b] : holes) {
-    if (b <= start) continue;
-    if (a >= s1) break;
-    if (a > start) out.push_back({start, a});
-    start = std::max(start, b);
-  }
-  if (start < s1) out.push_back({start, s1});
-  return out;
 }
 
 void PlaceCrossings(const SimulationOptions& options, World* world) {
@@ -254,18 +202,6 @@ void PaintBands(const SimulationOptions& options, World* world) {
 }
 
 // The stop line across the driving lane, 2 m before crossing `ci`.
-StopLine StopLineBefore(const World& world, int ci,
-                        const SimulationOptions& options) {
-  const Crossing& c = world.crossings[ci];
-  StopLine line;
-  line.width_m = 0.3;
-  line.s_m = c.s_min - 2.0 - 0.5 * line.width_m;
-  line.l0 = -0.5 * world.road.width_m() + kEdgeLineInsetM;
-  line.l1 = -0.5 * options.lane_line_width_m - 0.05;
-  line.crossing = ci;
-  return line;
-}
-
 void PaintLines(const SimulationOptions& options, World* world) {
   const Road& road = world->road;
   const double half = 0.5 * road.width_m();
@@ -356,14 +292,6 @@ void PlanDatabaseLineFaults(const SimulationOptions& options, World* world) {
   }
 }
 
-bool NearCrossing(const World& world, double s0, double s1, double margin) {
-  for (const Crossing& c : world.crossings) {
-    if (!c.in_street) continue;
-    if (s1 > c.s_min - margin && s0 < c.s_max + margin) return true;
-  }
-  return false;
-}
-
 void PlaceSmallMarks(const SimulationOptions& options, World* world) {
   std::mt19937_64 rng(SubSeed(options.seed, kMarksSeed, 2));
   const Road& road = world->road;
@@ -409,192 +337,46 @@ void PlaceSmallMarks(const SimulationOptions& options, World* world) {
   }
 }
 
-void BuildFacades(const SimulationOptions& options, World* world) {
-  if (!options.facades) return;
-  std::mt19937_64 rng(SubSeed(options.seed, kBuildingSeed));
-  const Road& road = world->road;
-  const double front = 0.5 * road.width_m() + options.sidewalk_width_m;
-  for (double side : {-1.0, 1.0}) {
-    double s = -10.0;
-    while (s < road.length_m() + 10.0) {
-      const double length = Uniform(&rng, 8.0, 26.0);
-      const double depth = Uniform(&rng, 10.0, 15.0);
-      const double height = Uniform(&rng, 7.0, 20.0);
-      const double gap = Bernoulli(&rng, options.facade_gap_probability)
-                             ? Uniform(&rng, 3.0, 8.0)
-                             : 0.0;
-      const double s0 = s, s1 = s + length;
-      s = s1 + gap;
-      const Eigen::Vector2d a =
-          road.Centre(s0) + side * front * road.LeftNormal(s0);
-      const Eigen::Vector2d b =
-          road.Centre(s1) + side * front * road.LeftNormal(s1);
-      Building building;
-      building.s0 = s0;
-      building.s1 = s1;
-      VerticalBox& box = building.box;
-      box.axis_u = (b - a).normalized();
-      box.half_u = 0.5 * (b - a).norm();
-      box.half_v = 0.5 * depth;
-      box.centre = 0.5 * (a + b) + side * 0.5 * depth * box.axis_v();
-      const double ground = std::min(
-          {road.Height(s0, side * front), road.Height(s1, side * front),
-           road.Height(0.5 * (s0 + s1), side * front)});
-      box.z0 = ground - 0.5;
-      box.z1 = ground + height;
-      building.front_side = side > 0 ? -1 : 1;
-      building.wall_tone = static_cast<float>(Uniform(&rng, 110.0, 185.0));
-      building.window_tone = static_cast<float>(Uniform(&rng, 30.0, 60.0));
-      building.window_period_m =
-          options.window_period_m * Uniform(&rng, 0.9, 1.1);
-      building.window_width_m =
-          building.window_period_m * Uniform(&rng, 0.38, 0.55);
-      building.window_height_m = Uniform(&rng, 1.3, 1.7);
-      building.sill_height_m = Uniform(&rng, 0.8, 1.0);
-      building.floor_height_m = Uniform(&rng, 2.9, 3.3);
-      building.ground_floor_height_m = Uniform(&rng, 3.6, 4.5);
-      const double face = 2.0 * box.half_u;
-      building.window_offset_m =
-          0.5 * (std::fmod(face, building.window_period_m) +
-                 building.window_period_m - building.window_width_m);
-      building.shop_front = Bernoulli(&rng, 0.5);
-      building.salt = rng();
-      world->buildings.push_back(building);
-    }
-  }
-}
-
-bool VehicleFits(const World& world, double s0, double s1, double side) {
-  if (NearCrossing(world, s0, s1, 0.5)) return false;
-  for (const ParkedVehicle& v : world.vehicles) {
-    const double v_side =
-        (v.box.centre - world.road.Centre(0.5 * (v.s0 + v.s1)))
-            .dot(world.road.LeftNormal(0.5 * (v.s0 + v.s1)));
-    if ((v_side > 0) == (side > 0) && s1 > v.s0 - 0.8 && s0 < v.s1 + 0.8) {
-      return false;
-    }
-  }
-  return true;
-}
-
-ParkedVehicle MakeVehicle(const Road& road, double s, double side,
-                          double length, std::mt19937_64* rng) {
-  ParkedVehicle v;
-  const double l = side * (0.5 * road.width_m() + 0.1);
-  v.box.centre = road.Centre(s) + l * road.LeftNormal(s);
-  v.box.axis_u = road.Tangent(s);
-  v.box.half_u = 0.5 * length;
-  v.box.half_v = 0.5 * Uniform(rng, 1.7, 1.9);
-  v.box.z0 = road.Height(s, l) - 0.05;
-  v.box.z1 = v.box.z0 + Uniform(rng, 1.4, 1.75);
-  v.body_tone = static_cast<float>(Uniform(rng, 25.0, 225.0));
-  v.s0 = s - 0.5 * length;
-  v.s1 = s + 0.5 * length;
-  v.salt = (*rng)();
-  return v;
-}
-
-void ParkVehicles(const SimulationOptions& options, World* world) {
-  std::mt19937_64 rng(SubSeed(options.seed, kVehicleSeed));
-  const Road& road = world->road;
-  // Vehicles hiding the outer bands of a crossing from the approach.
-  for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
-    Crossing& c = world->crossings[ci];
-    const bool want = Bernoulli(&rng, options.occluding_vehicle_probability);
-    const double length = Uniform(&rng, 4.0, 4.8);
-    const double gap = Uniform(&rng, 0.6, 1.5);
-    if (!want || !c.in_street) continue;
-    const double s = c.s_min - gap - 0.5 * length;
-    if (!VehicleFits(*world, s - 0.5 * length, s + 0.5 * length, -1.0)) {
-      continue;
-    }
-    ParkedVehicle v = MakeVehicle(road, s, -1.0, length, &rng);
-    v.occludes_crossing = true;
-    c.occluded_by_vehicle = true;
-    world->vehicles.push_back(v);
-  }
-  const int count = PoissonCount(
-      &rng, options.parked_vehicles_per_100m * world->road.length_m() / 100.0);
-  for (int i = 0; i < count; ++i) {
-    for (int attempt = 0; attempt < 20; ++attempt) {
-      const double length = Uniform(&rng, 4.0, 4.8);
-      const double s = Uniform(&rng, 3.0, road.length_m() - 3.0);
-      const double side = Bernoulli(&rng, 0.5) ? 1.0 : -1.0;
-      if (!VehicleFits(*world, s - 0.5 * length, s + 0.5 * length, side)) {
-        continue;
-      }
-      world->vehicles.push_back(MakeVehicle(road, s, side, length, &rng));
-      break;
-    }
-  }
-}
-
-// Vehicles parked at the kerb over a crossing's first or last band (after
-// every other vehicle, from their own generator: the other presets' streets
-// do not change with end_band_vehicle_probability).
-void ParkOverEndBands(const SimulationOptions& options, World* world) {
-  if (options.end_band_vehicle_probability <= 0.0) return;
-  std::mt19937_64 rng(SubSeed(options.seed, kVehicleSeed, 2));
-  const Road& road = world->road;
-  const double half_width = 0.5 * road.width_m();
-  for (Crossing& c : world->crossings) {
-    const bool want = Bernoulli(&rng, options.end_band_vehicle_probability);
-    const bool first = Bernoulli(&rng, 0.5);
-    const double length = Uniform(&rng, 4.0, 4.8);
-    const double along = Uniform(&rng, -1.0, 1.0);
-    // Its inner side 0.8-1.2 m from the kerb: over the outer band (0.25 m
-    // from the kerb, 0.5 m wide), not over the next one.
-    const double inner = Uniform(&rng, 0.8, 1.2);
-    if (!want || !c.in_street || c.num_street_bands < 2) continue;
-    const int band = first ? 1 : c.num_street_bands;
-    const double o =
-        c.first_offset_m + (band - 1) * c.band_period_m + 0.5 * c.band_width_m;
-    const double side = o < 0.0 ? -1.0 : 1.0;
-    // Only an outer band at the kerb can be under a parked vehicle, and not
-    // where the survey vehicle drives (its lane, with 1.8 m to spare).
-    if (half_width - std::abs(o) > 1.0) continue;
-    if (side * world->lane_offset_m > 0.0 &&
-        half_width - inner < std::abs(world->lane_offset_m) + 1.8) {
-      continue;
-    }
-    const double s = c.s_m + o * c.tan_skew + along;
-    ParkedVehicle v = MakeVehicle(road, s, side, length, &rng);
-    const double l_centre = side * (half_width - inner + v.box.half_v);
-    v.box.centre = road.Centre(s) + l_centre * road.LeftNormal(s);
-    v.box.z0 = road.Height(s, l_centre) - 0.05;
-    v.occludes_crossing = true;
-    c.end_band_vehicle = first ? "first" : "last";
-    world->vehicles.push_back(v);
-  }
-}
-
-void CastShadows(const SimulationOptions& options, World* world) {
-  if (!options.shadows || world->sun_enu.z() < 0.05) return;
-  const Road& road = world->road;
-  for (const Building& b : world->buildings) {
-    world->shadows.push_back(
-        CastShadow(b.box, b.box.z0 + 0.5, world->sun_enu, 0.45f));
-  }
-  for (const ParkedVehicle& v : world->vehicles) {
-    double s = 0.0, l = 0.0;
-    road.ToRoadCoordinates(v.box.centre, 0.5 * (v.s0 + v.s1), &s, &l);
-    world->shadows.push_back(
-        CastShadow(v.box, road.Height(s, l), world->sun_enu, 0.5f));
-    // Contact shadow under the body.
-    VerticalBox under = v.box;
-    under.half_u += 0.15;
-    under.half_v += 0.15;
-    under.z1 = under.z0;
-    Shadow contact;
-    for (const Eigen::Vector2d& p : under.Footprint()) {
-      contact.polygon.push_back(p);
-    }
-    contact.factor = 0.55f;
-    world->shadows.push_back(contact);
-  }
-}
-
 }  // namespace
+
+namespace world_internal {
+
+std::vector<std::pair<double, double>> Subtract(
+    double s0, double s1, std::vector<std::pair<double, double>> holes) {
+  std::sort(holes.begin(), holes.end());
+  std::vector<std::pair<double, double>> out;
+  double start = s0;
+  for (const auto& [a, b] : holes) {
+    if (b <= start) continue;
+    if (a >= s1) break;
+    if (a > start) out.push_back({start, a});
+    start = std::max(start, b);
+  }
+  if (start < s1) out.push_back({start, s1});
+  return out;
+}
+
+StopLine StopLineBefore(const World& world, int ci,
+                        const SimulationOptions& options) {
+  const Crossing& c = world.crossings[ci];
+  StopLine line;
+  line.width_m = 0.3;
+  line.s_m = c.s_min - 2.0 - 0.5 * line.width_m;
+  line.l0 = -0.5 * world.road.width_m() + kEdgeLineInsetM;
+  line.l1 = -0.5 * options.lane_line_width_m - 0.05;
+  line.crossing = ci;
+  return line;
+}
+
+bool NearCrossing(const World& world, double s0, double s1, double margin) {
+  for (const Crossing& c : world.crossings) {
+    if (!c.in_street) continue;
+    if (s1 > c.s_min - margin && s0 < c.s_max + margin) return true;
+  }
+  return false;
+}
+
+}  // namespace world_internal
 
 void Shadow::Finish() {
   edge_normals.clear();
@@ -681,176 +463,6 @@ World BuildWorld(const SimulationOptions& options) {
   CastShadows(options, &world);
   for (Shadow& shadow : world.shadows) shadow.Finish();
   return world;
-}
-
-namespace {
-
-// Samples of a line at constant l over [s0, s1], every `step` metres.
-std::vector<Eigen::Vector3d> SampleLine(const Road& road, double l, double s0,
-                                        double s1, double step) {
-  std::vector<Eigen::Vector3d> points;
-  const int n = std::max(1, static_cast<int>(std::ceil((s1 - s0) / step)));
-  for (int i = 0; i <= n; ++i) {
-    points.push_back(road.SurfacePoint(s0 + (s1 - s0) * i / n, l));
-  }
-  return points;
-}
-
-struct LineGeometry {
-  std::string id;
-  std::string type;
-  std::vector<Eigen::Vector3d> points;
-};
-
-std::vector<LineGeometry> LineGeometries(const World& world) {
-  std::vector<LineGeometry> out;
-  int dash = 0, solid = 0;
-  for (const LinePiece& line : world.lines) {
-    const bool dashed = line.type == "lane_dashed";
-    out.push_back({dashed ? "dash-" + std::to_string(++dash)
-                          : "solid-" + std::to_string(++solid),
-                   line.type,
-                   SampleLine(world.road, line.l_m, line.s0, line.s1,
-                              dashed ? 1.0 : 2.0)});
-  }
-  for (const StopLine& stop : world.stop_lines) {
-    const Road& road = world.road;
-    out.push_back({"stop-" + world.crossings[stop.crossing].id,
-                   "stop_line",
-                   {road.SurfacePoint(stop.s_m, stop.l0),
-                    road.SurfacePoint(stop.s_m, stop.l1)}});
-  }
-  return out;
-}
-
-// The database's copy of the lines: the street's, without the gaps, with
-// the moved stretches at their old position, plus the removed stop lines.
-std::vector<LineGeometry> DatabaseLineGeometries(
-    const World& world, const SimulationOptions& options) {
-  const std::vector<LineGeometry> street = LineGeometries(world);
-  std::vector<LineGeometry> out;
-  const Road& road = world.road;
-  for (size_t i = 0; i < world.lines.size(); ++i) {
-    const LinePiece& line = world.lines[i];
-    const double step = line.type == "lane_dashed" ? 1.0 : 2.0;
-    std::vector<std::pair<double, double>> gaps, not_here;
-    std::vector<const DatabaseLineFault*> moved;
-    for (const DatabaseLineFault& f : world.database_line_faults) {
-      if (std::abs(f.l_m - line.l_m) > 1e-6) continue;
-      if (f.kind == "gap") gaps.push_back({f.s0, f.s1});
-      if (f.kind == "gap" || f.kind == "moved")
-        not_here.push_back({f.s0, f.s1});
-      if (f.kind == "moved") moved.push_back(&f);
-    }
-    std::vector<LineGeometry> pieces;
-    for (const auto& [s0, s1] : Subtract(line.s0, line.s1, not_here)) {
-      pieces.push_back(
-          {"", line.type, SampleLine(road, line.l_m, s0, s1, step)});
-    }
-    for (const DatabaseLineFault* f : moved) {
-      const double s0 = std::max(line.s0, f->s0);
-      const double s1 = std::min(line.s1, f->s1);
-      for (const auto& [a, b] : Subtract(s0, s1, gaps)) {
-        pieces.push_back({"", line.type,
-                          SampleLine(road, line.l_m + f->shift_m, a, b, step)});
-      }
-    }
-    // A piece shorter than half a metre is not something an aerial survey
-    // would digitise.
-    int k = 0;
-    for (LineGeometry& piece : pieces) {
-      const double length = (piece.points.back() - piece.points.front()).norm();
-      if (length < 0.5) continue;
-      piece.id =
-          street[i].id + (pieces.size() > 1 ? "." + std::to_string(++k) : "");
-      out.push_back(std::move(piece));
-    }
-  }
-  for (size_t i = world.lines.size(); i < street.size(); ++i) {
-    out.push_back(street[i]);  // the stop lines
-  }
-  for (const DatabaseLineFault& f : world.database_line_faults) {
-    if (f.kind != "removed") continue;
-    const StopLine stop = StopLineBefore(world, f.crossing, options);
-    out.push_back({"stop-" + world.crossings[f.crossing].id,
-                   "stop_line",
-                   {road.SurfacePoint(stop.s_m, stop.l0),
-                    road.SurfacePoint(stop.s_m, stop.l1)}});
-  }
-  return out;
-}
-
-}  // namespace
-
-RoadmarkDatabase MakeTruthRoadmarks(const World& world,
-                                    const LocalFrame& frame) {
-  RoadmarkDatabase db;
-  for (const Band& band : world.bands) {
-    RoadmarkBand out;
-    out.crossing_id = world.crossings[band.crossing].id;
-    out.band = band.band;
-    for (int k = 0; k < 4; ++k) {
-      out.corners[k] = frame.GeodeticFromEnu(band.corners[k]);
-    }
-    db.bands.push_back(out);
-  }
-  for (const LineGeometry& line : LineGeometries(world)) {
-    RoadmarkLine out;
-    out.id = line.id;
-    out.type = line.type;
-    for (const Eigen::Vector3d& p : line.points) {
-      out.points.push_back(frame.GeodeticFromEnu(p));
-    }
-    db.lines.push_back(out);
-  }
-  return db;
-}
-
-RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
-                                       const SimulationOptions& options,
-                                       const LocalFrame& frame) {
-  std::mt19937_64 rng(SubSeed(options.seed, kDatabaseSeed));
-  const double sxy = options.database_sigma_xy_m;
-  const double sz = options.database_sigma_z_m;
-  auto noise = [&]() {
-    const double e = Gaussian(&rng, sxy);
-    const double n = Gaussian(&rng, sxy);
-    return Eigen::Vector3d(e, n, Gaussian(&rng, sz));
-  };
-  RoadmarkDatabase db;
-  for (const Crossing& c : world.crossings) {
-    if (!c.in_db) continue;
-    const Eigen::Vector2d origin = c.origin_xy - c.repaint_shift_xy;
-    for (int k = 1; k <= c.num_db_bands; ++k) {
-      if (std::find(c.db_missing_bands.begin(), c.db_missing_bands.end(), k) !=
-          c.db_missing_bands.end()) {
-        continue;  // the gap keeps the street's numbering
-      }
-      const auto corners = DesignBandCorners(world.road, c, k, origin);
-      RoadmarkBand out;
-      out.crossing_id = c.id;
-      out.band = k;
-      out.sigma_xy_m = sxy;
-      out.sigma_z_m = sz;
-      for (int v = 0; v < 4; ++v) {
-        out.corners[v] =
-            frame.GeodeticFromEnu(corners[v] + c.db_offset_enu + noise());
-      }
-      db.bands.push_back(out);
-    }
-  }
-  for (const LineGeometry& line : DatabaseLineGeometries(world, options)) {
-    RoadmarkLine out;
-    out.id = line.id;
-    out.type = line.type;
-    out.sigma_xy_m = sxy;
-    out.sigma_z_m = sz;
-    for (const Eigen::Vector3d& p : line.points) {
-      out.points.push_back(frame.GeodeticFromEnu(p + noise()));
-    }
-    db.lines.push_back(out);
-  }
-  return db;
 }
 
 }  // namespace zebrageo::sim

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "survey/input_error.h"
+#include "tests/survey/damaged_input.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -140,27 +141,41 @@ TEST(Exposures, RejectsTwoImagesOfOneCameraInAnExposure) {
                         "'left' (the other on line 2)"));
 }
 
-TEST(Exposures, TruncatedOrCorruptedFilesOnlyThrowInputError) {
+// Damaged files are refused naming exposures.csv, the line and the problem,
+// or still parse to what their rows say: at most the three images, each of
+// a camera of the rig, two per exposure at most.
+TEST(Exposures, TruncatedOrCorruptedFilesAreRefusedByLineOrReadSoundly) {
   const std::string text = std::string(kHeader) +
                            "1,100.25,left,images/l1.png\n"
                            "1,100.25,right,images/r1.png\n"
                            "2,100.5,left,images/l2.png\n";
-  for (size_t length = 0; length <= text.size(); ++length) {
-    try {
-      ParseExposures(text.substr(0, length), "exposures.csv", StereoRig());
-    } catch (const InputError&) {
-    }
-  }
-  for (size_t at = 0; at < text.size(); ++at) {
-    for (const char c : {'\0', ',', '\n', '"', 'e', '\xff'}) {
-      std::string corrupted = text;
-      corrupted[at] = c;
-      try {
-        ParseExposures(corrupted, "exposures.csv", StereoRig());
-      } catch (const InputError&) {
-      }
-    }
-  }
+  const Rig rig = StereoRig();
+  const DamageCounts counts = ParseDamagedCopies(
+      text, "exposures.csv", {'\0', ',', '\n', '"', 'e', '\xff'},
+      [&](const std::string& damaged) {
+        const ExposureTable table =
+            ParseExposures(damaged, "exposures.csv", rig);
+        EXPECT_GE(table.images.size(), 1u);
+        EXPECT_LE(table.images.size(), 3u);
+        EXPECT_LE(table.exposures.size(), table.images.size());
+        for (const ExposureImage& image : table.images) {
+          EXPECT_TRUE(image.camera == 0 || image.camera == 1);
+          EXPECT_FALSE(image.image.empty());
+        }
+        for (size_t k = 1; k < table.exposures.size(); ++k) {
+          EXPECT_LE(table.exposures[k - 1].time, table.exposures[k].time);
+        }
+      });
+  EXPECT_GT(counts.refused, 0);
+  EXPECT_GT(counts.parsed, 0);
+  // Cut after the first data row: one exposure with its left image only.
+  const ExposureTable first = ParseExposures(
+      text.substr(0, text.find("1,100.25,right")), "exposures.csv", rig);
+  ASSERT_EQ(first.exposures.size(), 1u);
+  EXPECT_EQ(first.exposures[0].image_of_camera, (std::vector<int>{0, -1}));
+  // Cut inside the header: the missing column is named on line 1.
+  EXPECT_THAT(ErrorOf(text.substr(0, 20)),
+              HasSubstr("exposures.csv:1: header lacks required column"));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "survey/input_error.h"
+#include "tests/survey/damaged_input.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -268,25 +269,45 @@ TEST(Rig, SuggestsTheImporterForOpenCvMatrices) {
 }
 
 // Files are untrusted: whatever the damage, the reader throws InputError
-// (never a yaml-cpp exception, never a crash).
-TEST(Rig, TruncatedOrCorruptedFilesOnlyThrowInputError) {
+// naming rig.yaml, the line and the problem (never a yaml-cpp exception,
+// never a crash), or reads a rig that holds together: named cameras with a
+// positive size, stereo pairs of two distinct cameras of the rig.
+TEST(Rig, TruncatedOrCorruptedFilesAreRefusedByLineOrReadSoundly) {
   const std::string text = RigText();
-  for (size_t length = 0; length <= text.size(); ++length) {
-    try {
-      ParseRig(text.substr(0, length), "rig.yaml");
-    } catch (const InputError&) {
-    }
-  }
-  for (size_t at = 0; at < text.size(); ++at) {
-    for (const char c : {'\0', '[', ':', '-', '\xff'}) {
-      std::string corrupted = text;
-      corrupted[at] = c;
-      try {
-        ParseRig(corrupted, "rig.yaml");
-      } catch (const InputError&) {
-      }
-    }
-  }
+  const DamageCounts counts = ParseDamagedCopies(
+      text, "rig.yaml", {'\0', '[', ':', '-', '\xff'},
+      [](const std::string& damaged) {
+        const Rig rig = ParseRig(damaged, "rig.yaml");
+        EXPECT_GE(rig.cameras.size(), 1u);
+        EXPECT_LE(rig.cameras.size(), 2u);
+        for (const RigCamera& camera : rig.cameras) {
+          EXPECT_FALSE(camera.camera.name().empty());
+          EXPECT_EQ(rig.FindCamera(camera.camera.name()),
+                    &camera - rig.cameras.data());
+        }
+        for (const std::array<int, 2>& pair : rig.stereo_pairs) {
+          EXPECT_NE(pair[0], pair[1]);
+          for (int camera : pair) {
+            EXPECT_GE(camera, 0);
+            EXPECT_LT(camera, static_cast<int>(rig.cameras.size()));
+          }
+        }
+      });
+  EXPECT_GT(counts.refused, 0);
+  EXPECT_GT(counts.parsed, 0);
+  // Cut before the right camera's T_body_cam: that camera, on its line.
+  EXPECT_THAT(ErrorOfParse(text.substr(0, text.rfind("    T_body_cam"))),
+              HasSubstr("rig.yaml:"));
+}
+
+// A NUL in a quoted value used to cut the message at it ("width '19"):
+// control bytes are shown escaped, the message keeps its problem.
+TEST(Rig, ControlBytesInAQuotedValueAreShownEscaped) {
+  std::string text = RigText();
+  text[text.find("1920") + 2] = '\0';
+  const std::string message = ErrorOfParse(text);
+  EXPECT_THAT(message, HasSubstr("rig.yaml:3: camera 'left' width '19\\x00"));
+  EXPECT_THAT(message, HasSubstr("' is not an integer"));
 }
 
 // --- OpenCV stereoCalibrate import ---------------------------------------

@@ -8,6 +8,7 @@
 
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "tests/survey/damaged_input.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -355,7 +356,10 @@ TEST(Roadmarks, ReadOfAMissingFileNamesIt) {
   }
 }
 
-TEST(Roadmarks, TruncatedOrCorruptedFilesOnlyThrowInputError) {
+// Damaged files are refused naming roadmarks.geojson, the line and the
+// problem, or read to at most the two bands and the line of the file, each
+// band with its crossing.
+TEST(Roadmarks, TruncatedOrCorruptedFilesAreRefusedByLineOrReadSoundly) {
   const std::string text =
       "\xEF\xBB\xBF" +
       Collection({BandFeature("C1", 1, 0.0), BandFeature("C1", 2, 1.0),
@@ -364,22 +368,22 @@ TEST(Roadmarks, TruncatedOrCorruptedFilesOnlyThrowInputError) {
                   "49.91, 1]]}, \"properties\": {\"type\": \"lane\", \"id\": "
                   "3}}"});
   EXPECT_EQ(ParseRoadmarks(text, "r").bands.size(), 2u);  // BOM accepted
-  for (size_t length = 0; length <= text.size(); ++length) {
-    try {
-      ParseRoadmarks(text.substr(0, length), "roadmarks.geojson");
-    } catch (const InputError&) {
-    }
-  }
-  for (size_t at = 0; at < text.size(); ++at) {
-    for (const char c : {'\0', '[', '{', '"', '1', ',', '\xff'}) {
-      std::string corrupted = text;
-      corrupted[at] = c;
-      try {
-        ParseRoadmarks(corrupted, "roadmarks.geojson");
-      } catch (const InputError&) {
-      }
-    }
-  }
+  const DamageCounts counts = ParseDamagedCopies(
+      text, "roadmarks.geojson", {'\0', '[', '{', '"', '1', ',', '\xff'},
+      [](const std::string& damaged) {
+        const RoadmarkDatabase db =
+            ParseRoadmarks(damaged, "roadmarks.geojson");
+        EXPECT_LE(db.bands.size(), 2u);
+        EXPECT_LE(db.lines.size(), 1u);
+        for (const RoadmarkBand& band : db.bands) {
+          EXPECT_FALSE(band.crossing_id.empty());
+        }
+      });
+  EXPECT_GT(counts.refused, 0);
+  EXPECT_GT(counts.parsed, 0);
+  // Cut inside the second band: malformed JSON, on the line it ends.
+  EXPECT_THAT(ErrorOf(text.substr(0, text.find("C1", text.find("C1") + 2))),
+              HasSubstr("malformed JSON"));
 }
 
 TEST(Roadmarks, NamesTheLineOfAFeatureAfterAByteOrderMark) {

@@ -211,13 +211,114 @@ INSTANTIATE_TEST_SUITE_P(
       return param.param.name;
     });
 
-// Visible in ctest's summary when the independent checker cannot run.
-TEST(BadSurveyScorer, IsAvailable) {
+// The independent checker the BadSurvey cases rely on must itself tell a
+// bad outcome from a good one: on hand-made outcomes of an "error" survey
+// and a "warning" survey (truth/meta.json as `simulate --bad` writes it), it
+// accepts the honest ones and rejects exit 0 where an error is due, outputs
+// left behind an error, a crash, a silent exit, a missing output, and a
+// finished run without a warning.
+struct ScorerCase {
+  std::string name;
+  std::string expect;                // meta.json's "expect": error or warning
+  int exit_code;                     // what the run is said to have returned
+  std::string stderr_text;           // what it is said to have printed
+  std::vector<std::string> outputs;  // contract outputs in the results
+  bool report_warns;                 // report.json holds a warning
+  bool accepted;                     // the scorer's expected verdict
+  std::string says;                  // in the scorer's one-line verdict
+};
+
+TEST(BadSurveyScorer, AcceptsHonestOutcomesAndRejectsDishonestOnes) {
   std::string why;
   if (!ScorerAvailable(&why)) {
     GTEST_SKIP() << "score_results.py badinput is not run by the BadSurvey "
                     "cases: "
                  << why;
+  }
+  const std::string message =
+      "zebrageo: error: rig.yaml:7: camera 'left' K: fx and fy must be > 0\n";
+  std::vector<std::string> all_but_report(kOutputs.begin(), kOutputs.end() - 1);
+  const std::vector<ScorerCase> cases = {
+      {"clear_error", "error", 1, message, {}, false, true, "clear error"},
+      {"error_exit_zero", "error", 0, "", kOutputs, true, false,
+       "exit 0 where an error was expected"},
+      {"error_leaves_outputs",
+       "error",
+       1,
+       message,
+       {"poses.csv"},
+       false,
+       false,
+       "outputs left behind: poses.csv"},
+      {"error_without_message",
+       "error",
+       1,
+       "",
+       {},
+       false,
+       false,
+       "without a message"},
+      {"crash",
+       "error",
+       134,
+       "terminate called after throwing\n",
+       {},
+       false,
+       false,
+       "crashed (exit 134)"},
+      {"abort_message",
+       "error",
+       1,
+       "Aborted (core dumped)\n",
+       {},
+       false,
+       false,
+       "crashed"},
+      {"warned_result", "warning", 0, "", kOutputs, true, true,
+       "finished with warnings"},
+      {"warning_survey_fails",
+       "warning",
+       1,
+       message,
+       {},
+       false,
+       false,
+       "still usable"},
+      {"warning_output_missing", "warning", 0, "", all_but_report, true, false,
+       "outputs missing: report.json"},
+      {"finished_without_warning", "warning", 0, "", kOutputs, false, false,
+       "without a warning"},
+  };
+  for (const ScorerCase& c : cases) {
+    SCOPED_TRACE(c.name);
+    TemporaryFolder folder;
+    const std::string survey = folder.Path("survey");
+    const std::string results = folder.Path("results");
+    const json meta = {{"bad", "bad_focal"}, {"expect", c.expect}};
+    folder.Write("survey/truth/meta.json", meta.dump(2));
+    fs::create_directories(results);
+    for (const std::string& output : c.outputs) {
+      std::string text = "x\n";
+      if (output == "report.json") {
+        text = json{{"warnings", c.report_warns ? json::array({"a warning"})
+                                                : json::array()}}
+                   .dump();
+      }
+      folder.Write("results/" + output, text);
+    }
+    const std::string err_path = folder.Write("run.err", c.stderr_text);
+    const std::string command =
+        "/usr/bin/python3 " +
+        Quote(std::string(ZEBRAGEO_SHARED_DIR) + "/tools/score_results.py") +
+        " badinput " + Quote(survey) + " " + Quote(results) + " --exit-code " +
+        std::to_string(c.exit_code) + " --stderr " + Quote(err_path) + " > " +
+        Quote(folder.Path("score.out")) + " 2>&1";
+    const int status = std::system(command.c_str());
+    const std::string verdict = ReadWholeFile(folder.Path("score.out"));
+    ASSERT_TRUE(WIFEXITED(status)) << verdict;
+    EXPECT_EQ(WEXITSTATUS(status), c.accepted ? 0 : 1) << verdict;
+    EXPECT_NE(verdict.find(c.says), std::string::npos)
+        << verdict << "\n  lacks: " << c.says;
   }
 }
 

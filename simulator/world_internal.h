@@ -1,0 +1,47 @@
+// Internals of the world builder shared by its files (world.cc: road,
+// crossings and marks; world_scenery.cc: buildings, parked vehicles and
+// shadows; world_database.cc: the truth and database road marks). Not part
+// of the simulator's interface.
+#ifndef ZEBRAGEO_SIMULATOR_WORLD_INTERNAL_H_
+#define ZEBRAGEO_SIMULATOR_WORLD_INTERNAL_H_
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "simulator/simulator.h"
+#include "simulator/world.h"
+
+namespace zebrageo::sim::world_internal {
+
+// Purposes of the sub-generators (SubSeed).
+enum Purpose : uint64_t {
+  kRoadSeed = 1,
+  kCrossingSeed = 2,
+  kMarksSeed = 3,
+  kDatabaseSeed = 4,
+  kBuildingSeed = 5,
+  kVehicleSeed = 6,
+  kTextureSeed = 9,
+};
+
+// The s-intervals of [s0, s1] left after removing `holes` (sorted, merged).
+std::vector<std::pair<double, double>> Subtract(
+    double s0, double s1, std::vector<std::pair<double, double>> holes);
+
+// The stop line painted 2 m before crossing `ci`, across the right lane.
+StopLine StopLineBefore(const World& world, int ci,
+                        const SimulationOptions& options);
+
+// True when [s0, s1] comes within `margin` of a crossing in the street.
+bool NearCrossing(const World& world, double s0, double s1, double margin);
+
+// The scenery (world_scenery.cc), in this order after the road marks.
+void BuildFacades(const SimulationOptions& options, World* world);
+void ParkVehicles(const SimulationOptions& options, World* world);
+void ParkOverEndBands(const SimulationOptions& options, World* world);
+void CastShadows(const SimulationOptions& options, World* world);
+
+}  // namespace zebrageo::sim::world_internal
+
+#endif  // ZEBRAGEO_SIMULATOR_WORLD_INTERNAL_H_

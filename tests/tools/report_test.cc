@@ -1,0 +1,226 @@
+// The report without a browser: `zebrageo run` on a small simulated survey
+// writes report.json with the figures of SURVEY_FORMAT.md and a report.html
+// whose sections and plots are all there, every inline SVG well-formed XML
+// with something drawn; `zebrageo report` rebuilds the same report from the
+// results folder alone. (ctest report_render also renders the page in
+// headless Chromium when it is installed.)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "tests/survey/test_util.h"
+#include "tests/tools/cli_util.h"
+
+namespace zebrageo {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// "" when `xml` is one well-formed element (tags nested and closed, quoted
+// attributes, no bare '<' or '&' in text), else what is wrong and where.
+std::string XmlProblem(const std::string& xml) {
+  std::vector<std::string> open;
+  size_t at = 0;
+  auto where = [&](const std::string& problem) {
+    return problem + " at byte " + std::to_string(at) + ": " +
+           xml.substr(at, 60);
+  };
+  const std::regex entity("^&(amp|lt|gt|quot|apos|#[0-9]+|#x[0-9a-fA-F]+);");
+  while (at < xml.size()) {
+    if (xml[at] == '&') {
+      std::smatch m;
+      const std::string rest = xml.substr(at, 12);
+      if (!std::regex_search(rest, m, entity)) return where("bare '&'");
+      at += m.length(0);
+      continue;
+    }
+    if (xml[at] != '<') {
+      if (open.empty() && !std::isspace(static_cast<unsigned char>(xml[at]))) {
+        return where("text outside the root element");
+      }
+      ++at;
+      continue;
+    }
+    const size_t end = xml.find('>', at);
+    if (end == std::string::npos) return where("unclosed tag");
+    const std::string tag = xml.substr(at + 1, end - at - 1);
+    if (tag.find('<') != std::string::npos) return where("'<' inside a tag");
+    static const std::regex close_tag(R"(^/([A-Za-z][\w:.-]*)\s*$)");
+    static const std::regex open_tag(
+        R"(^([A-Za-z][\w:.-]*)((\s+[A-Za-z_:][\w:.-]*\s*=\s*('[^'<]*'|"[^"<]*"))*)\s*(/?)$)");
+    std::smatch m;
+    if (std::regex_match(tag, m, close_tag)) {
+      if (open.empty() || open.back() != m[1].str()) {
+        return where("</" + m[1].str() + "> closes " +
+                     (open.empty() ? std::string("nothing") : open.back()));
+      }
+      open.pop_back();
+      if (open.empty() && xml.find('<', end) != std::string::npos) {
+        return where("a second root element");
+      }
+    } else if (std::regex_match(tag, m, open_tag)) {
+      if (m[5].str() != "/") open.push_back(m[1].str());
+    } else {
+      return where("malformed tag");
+    }
+    at = end + 1;
+  }
+  if (!open.empty()) return "<" + open.back() + "> never closed";
+  return "";
+}
+
+TEST(XmlProblem, TellsWellFormedFromBroken) {
+  EXPECT_EQ(XmlProblem("<svg a='1' b=\"2\"><g><rect x='0'/></g>&amp;</svg>"),
+            "");
+  EXPECT_NE(XmlProblem("<svg><g></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg><rect x=1/></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg><text>a & b</text></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg><text>a < b</text></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg>"), "");
+  EXPECT_NE(XmlProblem("<svg></svg><svg></svg>"), "");
+}
+
+// Every inline <svg>...</svg> of a page.
+std::vector<std::string> SvgElements(const std::string& html) {
+  std::vector<std::string> svgs;
+  for (size_t at = html.find("<svg"); at != std::string::npos;
+       at = html.find("<svg", at + 1)) {
+    const size_t end = html.find("</svg>", at);
+    if (end == std::string::npos) {
+      svgs.push_back(html.substr(at));
+      break;
+    }
+    svgs.push_back(html.substr(at, end + 6 - at));
+  }
+  return svgs;
+}
+
+// report.json's figures: what a program reading it relies on.
+void ExpectReportFigures(const json& report) {
+  EXPECT_EQ(report.at("zebrageo_version"), ZEBRAGEO_VERSION);
+  const json& survey = report.at("survey");
+  EXPECT_GT(survey.at("exposures").get<int>(), 10);
+  EXPECT_GT(survey.at("database_bands").get<int>(), 0);
+  const json& counts = report.at("counts");
+  EXPECT_GE(counts.at("matched_crossings").get<int>(), 2);
+  EXPECT_GT(counts.at("matched_vertices").get<int>(), 0);
+  // The adjustment brings the bands' image residuals down.
+  EXPECT_LT(report.at("rms_after").at("control_image").get<double>(),
+            report.at("rms_before").at("control_image").get<double>());
+  const json& control = report.at("gcp").at("control");
+  EXPECT_GE(control.at("crossings").get<int>(), 2);
+  EXPECT_GT(control.at("rmse_3d_m").get<double>(), 0.0);
+  EXPECT_LT(control.at("rmse_3d_m").get<double>(), 0.5);
+  EXPECT_LE(control.at("rmse_3d_m").get<double>(),
+            control.at("max_3d_m").get<double>());
+  EXPECT_EQ(report.at("crossings").size(),
+            static_cast<size_t>(counts.at("matched_crossings").get<int>()));
+  const json& timings = report.at("timings_s");
+  for (const char* stage : {"reconstruct", "match", "adjust"}) {
+    EXPECT_GE(timings.at(stage).get<double>(), 0.0) << stage;
+  }
+  EXPECT_GT(timings.at("total").get<double>(), 0.0);
+  EXPECT_TRUE(report.at("warnings").is_array());
+  EXPECT_TRUE(report.at("corrections").contains("rms_horizontal_m"));
+}
+
+// report.html: every section, every plot, well-formed, finite numbers.
+void ExpectReportPage(const std::string& html, const json& report) {
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_NE(html.find("<h1>zebrageo report: zebrageo-sim-demo-seed1</h1>"),
+            std::string::npos);
+  EXPECT_NE(html.find("</html>"), std::string::npos) << "page cut short";
+  for (const char* section :
+       {"Warnings", "Accuracy", "Trajectory", "Ground control residuals",
+        "Crossings", "Database faults found", "Stretches without control",
+        "Road lines", "Counts", "Stage timings", "Adjustment", "Matching"}) {
+    EXPECT_NE(html.find(std::string("<h2>") + section + "</h2>"),
+              std::string::npos)
+        << section;
+  }
+  for (const json& warning : report.at("warnings")) {
+    EXPECT_NE(html.find(warning.get<std::string>()), std::string::npos)
+        << "warning not shown: " << warning;
+  }
+  const std::vector<std::string> svgs = SvgElements(html);
+  std::vector<std::string> titles;
+  for (const std::string& svg : svgs) {
+    EXPECT_EQ(XmlProblem(svg), "") << svg.substr(0, 200);
+    EXPECT_TRUE(
+        std::regex_search(svg, std::regex("<(polyline|circle|path|rect) ")))
+        << "nothing drawn: " << svg.substr(0, 200);
+    std::smatch title;
+    if (std::regex_search(svg, title,
+                          std::regex("font-weight='bold'>([^<]*)<"))) {
+      titles.push_back(title[1]);
+    }
+  }
+  const std::vector<std::string> expected = {
+      "Residual RMS before and after the adjustment",
+      "Trajectory and correction magnitude",
+      "Trajectory correction (corrected minus input)",
+      "Heading correction",
+      "Horizontal GCP residuals (adjusted minus database)",
+      "Control points: 3D residual",
+      "Road-line control per stretch"};
+  EXPECT_EQ(titles, expected);
+  EXPECT_FALSE(std::regex_search(html, std::regex(R"(\b(nan|NaN|inf)\b)")))
+      << "NaN or infinity in the page";
+}
+
+TEST(Report, RunWritesItsFiguresAndWellFormedPlotsAndReportRebuildsIt) {
+  TemporaryFolder folder;
+  const std::string survey = folder.Path("survey");
+  const std::string results = folder.Path("results");
+  ASSERT_EQ(RunZebrageo("--log-level error simulate " + SmallSurveyArguments() +
+                            " -o " + Quote(survey),
+                        folder.Path("sim.out"), folder.Path("sim.err")),
+            0)
+      << ReadWholeFile(folder.Path("sim.err"));
+  ASSERT_EQ(RunZebrageo("--log-level error run " + Quote(survey) + " -o " +
+                            Quote(results),
+                        folder.Path("run.out"), folder.Path("run.err")),
+            0)
+      << ReadWholeFile(folder.Path("run.err"));
+  const json report = json::parse(ReadWholeFile(results + "/report.json"));
+  {
+    SCOPED_TRACE("report.json");
+    ExpectReportFigures(report);
+  }
+  {
+    SCOPED_TRACE("report.html");
+    ExpectReportPage(ReadWholeFile(results + "/report.html"), report);
+  }
+
+  // `zebrageo report` from the results folder alone: the same figures.
+  fs::remove(results + "/report.json");
+  fs::remove(results + "/report.html");
+  ASSERT_EQ(RunZebrageo("--log-level error report " + Quote(survey) + " -o " +
+                            Quote(results),
+                        folder.Path("report.out"), folder.Path("report.err")),
+            0)
+      << ReadWholeFile(folder.Path("report.err"));
+  const json rebuilt = json::parse(ReadWholeFile(results + "/report.json"));
+  for (const char* key : {"counts", "rms_before", "rms_after", "gcp",
+                          "crossings", "corrections", "survey"}) {
+    EXPECT_EQ(rebuilt.at(key), report.at(key)) << key;
+  }
+  // The same warnings; `run` lists them in the order the stages gave them.
+  std::vector<std::string> warnings = report.at("warnings");
+  std::vector<std::string> rebuilt_warnings = rebuilt.at("warnings");
+  std::sort(warnings.begin(), warnings.end());
+  std::sort(rebuilt_warnings.begin(), rebuilt_warnings.end());
+  EXPECT_EQ(rebuilt_warnings, warnings);
+  SCOPED_TRACE("rebuilt report.html");
+  ExpectReportPage(ReadWholeFile(results + "/report.html"), rebuilt);
+}
+
+}  // namespace
+}  // namespace zebrageo
