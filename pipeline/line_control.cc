@@ -94,6 +94,106 @@ std::vector<RejectedLine> RejectLinesAwayFromTrajectory(
   return rejected;
 }
 
+// The reconstructed line points in ENU with the trajectory the zebra
+// crossings corrected (those at an exposure it covers), with where each
+// came from, the pose and its time.
+struct LinePointsEnu {
+  std::vector<LinePointEnu> enu;
+  std::vector<int> source;  // index into the reconstructed points
+  std::vector<Pose> pose_of;
+  std::vector<double> time_of;
+};
+LinePointsEnu LinePointsInEnu(
+    const std::vector<ReconstructedLinePoint>& points,
+    const std::unordered_map<int64_t, double>& exposure_time,
+    const AdjustmentResult& zebra_result) {
+  LinePointsEnu out;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto t = exposure_time.find(points[i].exposure_id);
+    Pose pose;
+    if (t == exposure_time.end() ||
+        !CorrectedPoseAt(zebra_result, t->second, &pose)) {
+      continue;
+    }
+    out.enu.push_back({points[i].line_id, RoadLineTypeName(points[i].type),
+                       pose.T_enu_body() * points[i].p_body});
+    out.source.push_back(static_cast<int>(i));
+    out.pose_of.push_back(pose);
+    out.time_of.push_back(t->second);
+  }
+  return out;
+}
+
+// Warns of each rejected database line (the report's wording, so the
+// warning is listed once in report.json) and lists it in `summary`.
+void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
+                       const std::vector<DatabaseLineEnu>& database,
+                       LineControlRecord* summary,
+                       std::vector<std::string>* warnings) {
+  for (const RejectedLine& r : rejected) {
+    const DatabaseLineEnu& line = database[r.db_line];
+    std::ostringstream w;
+    w << "database: road line " << line.id << " (" << line.type << ") lies "
+      << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
+      << " m across from where the other lines put it: repainted or stale, "
+         "not used as control";
+    LOG(WARNING) << w.str();
+    warnings->push_back(w.str());
+    summary->rejected_lines.push_back(
+        {line.id, line.type, r.points, r.offset_m});
+  }
+}
+
+// The control point of a line point matched to a database line; `shared`:
+// how many points share its database segment's error, square-rooted.
+// *cross_track: whether the line runs with the vehicle (then it controls
+// the cross-track position, else the height only).
+LineControlPoint ControlPointOf(const ReconstructedLinePoint& p, double time,
+                                const Pose& pose, const LinePointMatch& m,
+                                const DatabaseLineEnu& line, double shared,
+                                const AdjustmentOptions& options,
+                                bool* cross_track) {
+  LineControlPoint c;
+  c.time = time;
+  c.p_body = p.p_body;
+  c.db_point_enu = m.db_point_enu;
+  c.across_enu = m.across_enu;
+  c.along_enu = m.along_enu;
+  c.grade =
+      DatabaseLineGrade(line, m.db_segment, m.db_segment_t, kGradeHalfWindowM);
+  c.sqrt_information = LineSqrtInformation(
+      p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
+      shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),
+      shared * std::max(line.sigma_z_m, options.min_database_sigma_m));
+  // Across the line is cross-track when the line runs with the vehicle.
+  const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
+  *cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
+  if (!*cross_track) {
+    // A line across the road (a stop line) would control the along-track
+    // position, which the zebra crossings it lies beside already hold; a
+    // database's stop lines are drawn loosely (an aerial image shows a
+    // thick bar, a give-way line beside it), so it controls the height
+    // only.
+    c.sqrt_information.row(0).setZero();
+  }
+  return c;
+}
+
+// Logs the line control per stretch of stretch_s seconds.
+void LogLineControl(size_t used, size_t reconstructed, double stretch_s,
+                    const std::map<int, std::array<int, 3>>& stretches) {
+  std::ostringstream report;
+  report << "road lines: " << used << " of " << reconstructed
+         << " line points matched to database lines; per " << stretch_s
+         << " s stretch (cross-track/height/along-track points):";
+  for (const auto& [k, s] : stretches) {
+    report << " [+" << k * stretch_s << " s: " << s[0] << "/" << s[1] << "/"
+           << s[2] << "]";
+  }
+  LOG(INFO) << report.str();
+  LOG(INFO) << "road lines control cross-track and height between crossings";
+}
+
 }  // namespace
 
 std::vector<LineControlPoint> MatchLinesForAdjustment(
@@ -116,40 +216,22 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   for (const Exposure& e : data.exposures.exposures) {
     exposure_time[e.exposure_id] = e.time;
   }
-  // In ENU with the trajectory the zebra crossings corrected.
-  std::vector<LinePointEnu> enu;
-  std::vector<int> source;
-  std::vector<Pose> pose_of;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const auto t = exposure_time.find(points[i].exposure_id);
-    Pose pose;
-    if (t == exposure_time.end() ||
-        !CorrectedPoseAt(zebra_result, t->second, &pose)) {
-      continue;
-    }
-    enu.push_back({points[i].line_id, RoadLineTypeName(points[i].type),
-                   pose.T_enu_body() * points[i].p_body});
-    source.push_back(static_cast<int>(i));
-    pose_of.push_back(pose);
-  }
+  const LinePointsEnu line_points =
+      LinePointsInEnu(points, exposure_time, zebra_result);
   const std::vector<DatabaseLineEnu> database =
       DatabaseLinesEnu(data.roadmarks, data.frame);
   const std::vector<LinePointMatch> all_matches =
-      MatchLinePoints(enu, database, LineMatchOptions());
-  std::vector<double> point_time(enu.size());
-  for (size_t i = 0; i < enu.size(); ++i) {
-    point_time[i] = exposure_time[points[source[i]].exposure_id];
-  }
+      MatchLinePoints(line_points.enu, database, LineMatchOptions());
   std::vector<LinePointMatch> consistent;
   std::vector<RejectedLine> rejected = RejectInconsistentLines(
-      all_matches, point_time, LineConsistencyOptions(), &consistent);
+      all_matches, line_points.time_of, LineConsistencyOptions(), &consistent);
   // A database line must also agree with the trajectory the zebra crossings
   // corrected, to what that trajectory's posterior sd allows: a line the
   // zebras place decimetres away is stale or mismatched, and would pull
   // the trajectory off the crossings.
-  std::vector<double> sd_of_point(enu.size(), 0.0);
-  for (size_t i = 0; i < enu.size(); ++i) {
-    sd_of_point[i] = PosteriorSdAt(zebra_result, point_time[i]);
+  std::vector<double> sd_of_point(line_points.enu.size(), 0.0);
+  for (size_t i = 0; i < line_points.enu.size(); ++i) {
+    sd_of_point[i] = PosteriorSdAt(zebra_result, line_points.time_of[i]);
   }
   std::vector<LinePointMatch> matches;
   for (const RejectedLine& r :
@@ -157,20 +239,7 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     rejected.push_back(r);
   }
   LineControlRecord summary;
-  for (const RejectedLine& r : rejected) {
-    const DatabaseLineEnu& line = database[r.db_line];
-    // The report's wording (tools/report/report.cc), so the warning is
-    // listed once in report.json.
-    std::ostringstream w;
-    w << "database: road line " << line.id << " (" << line.type << ") lies "
-      << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
-      << " m across from where the other lines put it: repainted or stale, "
-         "not used as control";
-    LOG(WARNING) << w.str();
-    warnings->push_back(w.str());
-    summary.rejected_lines.push_back(
-        {line.id, line.type, r.points, r.offset_m});
-  }
+  WarnRejectedLines(rejected, database, &summary, warnings);
 
   std::vector<LineMatch> rows;
   // Per 30 s stretch: matches, and the directions controlled.
@@ -188,37 +257,16 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     ++points_on_segment[{m.db_line, m.db_segment}];
   }
   for (const LinePointMatch& m : matches) {
-    const ReconstructedLinePoint& p = points[source[m.point]];
+    const ReconstructedLinePoint& p = points[line_points.source[m.point]];
     const double shared = std::sqrt(
         static_cast<double>(points_on_segment[{m.db_line, m.db_segment}]));
-    const Pose& pose = pose_of[m.point];
     const DatabaseLineEnu& line = database[m.db_line];
-    LineControlPoint c;
-    c.time = exposure_time[p.exposure_id];
-    c.p_body = p.p_body;
-    c.db_point_enu = m.db_point_enu;
-    c.across_enu = m.across_enu;
-    c.along_enu = m.along_enu;
-    c.grade = DatabaseLineGrade(line, m.db_segment, m.db_segment_t,
-                                kGradeHalfWindowM);
-    c.sqrt_information = LineSqrtInformation(
-        p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
-        shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),
-        shared * std::max(line.sigma_z_m, options.min_database_sigma_m));
-    // Across the line is cross-track when the line runs with the vehicle.
-    const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
-    const bool cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
-    if (!cross_track) {
-      // A line across the road (a stop line) would control the along-track
-      // position, which the zebra crossings it lies beside already hold; a
-      // database's stop lines are drawn loosely (an aerial image shows a
-      // thick bar, a give-way line beside it), so it controls the height
-      // only.
-      c.sqrt_information.row(0).setZero();
-    }
-    control.push_back(c);
+    bool cross_track = false;
+    control.push_back(ControlPointOf(p, exposure_time[p.exposure_id],
+                                     line_points.pose_of[m.point], m, line,
+                                     shared, options, &cross_track));
     auto& s = stretches[static_cast<int>(
-        std::floor((c.time - start_time) / stretch_s))];
+        std::floor((control.back().time - start_time) / stretch_s))];
     if (cross_track) s[0] += 1;
     s[1] += 1;
     rows.push_back({p.exposure_id, p.line_id, p.point, p.type, line.id,
@@ -236,16 +284,7 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
                                  start_time + k * stretch_s, s[0], s[1], s[2]});
   }
   WriteLineControl(summary, (folder / kLineControlFile).string());
-  std::ostringstream report;
-  report << "road lines: " << matches.size() << " of " << points.size()
-         << " line points matched to database lines; per " << stretch_s
-         << " s stretch (cross-track/height/along-track points):";
-  for (const auto& [k, s] : stretches) {
-    report << " [+" << k * stretch_s << " s: " << s[0] << "/" << s[1] << "/"
-           << s[2] << "]";
-  }
-  LOG(INFO) << report.str();
-  LOG(INFO) << "road lines control cross-track and height between crossings";
+  LogLineControl(matches.size(), points.size(), stretch_s, stretches);
   return control;
 }
 
