@@ -1,0 +1,232 @@
+// The second registration pass of `zebrageo run` (match_stage.h): the
+// observations the first pass left undecided, matched again on the
+// trajectory the adjustment corrected.
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include "registration/match_stage.h"
+#include "registration/paint_probe.h"
+#include "survey/input_error.h"
+#include "survey/results_adjustment.h"
+
+namespace zebrageo {
+
+namespace fs = std::filesystem;
+
+std::string RematchOptions::Check() const {
+  if (min_control_crossings < 1) {
+    return "min_control_crossings = " + std::to_string(min_control_crossings) +
+           ": must be >= 1";
+  }
+  if (!(gate_m > 0.0) || !std::isfinite(gate_m)) {
+    return "gate_m = " + std::to_string(gate_m) + ": must be finite and > 0";
+  }
+  if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
+    return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
+           ": must be finite and > 0";
+  }
+  if (!(max_heading_error_rad > 0.0) || !(max_heading_error_rad < 0.5)) {
+    return "max_heading_error_rad = " + std::to_string(max_heading_error_rad) +
+           ": must be in (0, 0.5)";
+  }
+  return "";
+}
+
+namespace {
+
+// "" when the adjustment (its adjustment.json, survey/results_adjustment.h)
+// can gate the second pass, else why not.
+std::string AdjustmentUnfitForRematch(const std::string& results_folder,
+                                      int min_control_crossings) {
+  const fs::path path = fs::path(results_folder) / kAdjustmentJsonFile;
+  if (!fs::exists(path)) {
+    return std::string(kAdjustmentJsonFile) + " is missing";
+  }
+  AdjustmentRecord record;
+  try {
+    record = ReadAdjustmentRecord(path.string(), kAdjustmentJsonFile);
+  } catch (const InputError&) {
+    return std::string(kAdjustmentJsonFile) + " is not readable JSON";
+  }
+  if (!record.posterior_sd_computed) {
+    return "the adjustment has no posterior covariance to gate it";
+  }
+  const int crossings =
+      record.counts.control_crossings + record.counts.check_crossings;
+  if (crossings < min_control_crossings) {
+    return "the adjustment has " + std::to_string(crossings) +
+           " control crossings (" + std::to_string(min_control_crossings) +
+           " needed to trust its error model)";
+  }
+  return "";
+}
+
+// The second pass: the bands matched again on the survey as the adjustment
+// left it (its corrected trajectory), with the rematch gates. *bands_of:
+// the band ids of each observation (exposure, group).
+MatchResult MatchOnAdjustedTrajectory(
+    const Survey& survey, const fs::path& folder, const MatchOptions& options,
+    const RematchOptions& rematch,
+    std::map<std::pair<int64_t, int64_t>, std::set<int64_t>>* bands_of) {
+  Survey adjusted = survey;
+  adjusted.trajectory = Trajectory(
+      ReadTrajectorySamples((folder / kTrajectoryCorrectedFile).string(),
+                            kTrajectoryCorrectedFile),
+      survey.frame);
+  const std::vector<ReconstructedVertex> vertices = ReadReconstructedBands(
+      (folder / kReconstructedBandsFile).string(), kReconstructedBandsFile);
+  MatchInput input;
+  input.observations =
+      BuildObservations(adjusted, vertices, kReconstructedBandsFile, nullptr);
+  input.exposures = ExposurePoses(adjusted);
+  const RoadmarkIndex index(adjusted.roadmarks, adjusted.frame);
+  input.index = &index;
+  input.rig = &adjusted.rig;
+  ImagePaintProbe probe(adjusted);
+  input.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
+                               const BandCornersEnu& band,
+                               const std::vector<BandCornersEnu>& seen) {
+    return probe.Classify(exposure_id, pose, band, seen);
+  };
+  MatchOptions tight = options;
+  tight.max_drift_m = rematch.gate_m;
+  tight.sd_gate_factor = rematch.sd_gate_factor;
+  tight.max_heading_error_rad = rematch.max_heading_error_rad;
+  for (const CrossingObservation& o : input.observations) {
+    for (const ObservedBand& b : o.bands) {
+      (*bands_of)[{o.exposure_id, o.group_id}].insert(b.band_id);
+    }
+  }
+  return MatchBands(input, tight);
+}
+
+// Vertex matches of the first pass that the second makes differently.
+int Disagreements(const std::vector<VertexMatch>& first,
+                  const std::vector<VertexMatch>& second) {
+  std::map<std::tuple<int64_t, int64_t, int>, const VertexMatch*> first_match;
+  for (const VertexMatch& m : first) {
+    first_match[{m.exposure_id, m.band_id, m.vertex}] = &m;
+  }
+  int disagreements = 0;
+  for (const VertexMatch& m : second) {
+    const auto f = first_match.find({m.exposure_id, m.band_id, m.vertex});
+    if (f != first_match.end() &&
+        (f->second->crossing_id != m.crossing_id || f->second->band != m.band ||
+         f->second->db_vertex != m.db_vertex)) {
+      ++disagreements;
+    }
+  }
+  return disagreements;
+}
+
+// The first pass's decisions with the observations it left undecided and
+// the second matched; their vertex matches are added to *matches.
+std::vector<CrossingDecision> MergeSecondPass(
+    const std::vector<CrossingDecision>& first, const MatchResult& second,
+    const std::map<std::pair<int64_t, int64_t>, std::set<int64_t>>& bands_of,
+    const RematchOptions& rematch, std::vector<VertexMatch>* matches,
+    RematchSummary* summary) {
+  std::vector<CrossingDecision> merged = first;
+  for (CrossingDecision& d : merged) {
+    if (d.decision == Decision::kMatched) continue;
+    const auto it = std::find_if(
+        second.decisions.begin(), second.decisions.end(),
+        [&](const CrossingDecision& s) {
+          return s.exposure_id == d.exposure_id && s.group_id == d.group_id;
+        });
+    if (it == second.decisions.end() || it->decision != Decision::kMatched) {
+      continue;
+    }
+    const auto bands = bands_of.find({d.exposure_id, d.group_id});
+    int added_vertices = 0;
+    for (const VertexMatch& m : second.matches) {
+      if (bands != bands_of.end() && m.exposure_id == d.exposure_id &&
+          bands->second.count(m.band_id)) {
+        matches->push_back(m);
+        ++added_vertices;
+      }
+    }
+    if (added_vertices == 0) continue;
+    d.decision = Decision::kMatched;
+    d.crossing_id = it->crossing_id;
+    d.reason = "matched with the adjusted trajectory (second pass; gate " +
+               std::to_string(rematch.gate_m).substr(0, 4) +
+               " m or 5 posterior sd): " + it->reason +
+               "; first pass: " + d.reason;
+    ++summary->added;
+  }
+  return merged;
+}
+
+}  // namespace
+
+RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
+                                             const std::string& results_folder,
+                                             const MatchOptions& options,
+                                             const RematchOptions& rematch) {
+  RematchSummary summary;
+  const fs::path folder(results_folder);
+  const std::string unfit =
+      AdjustmentUnfitForRematch(results_folder, rematch.min_control_crossings);
+  if (!unfit.empty()) {
+    summary.message = "second registration pass skipped: " + unfit;
+    return summary;
+  }
+  const std::vector<CrossingDecision> first = ReadCrossingDecisions(
+      (folder / kCrossingDecisionsFile).string(), kCrossingDecisionsFile);
+  std::vector<VertexMatch> matches =
+      ReadMatches((folder / kMatchesFile).string(), kMatchesFile);
+  for (const CrossingDecision& d : first) {
+    summary.observations += d.decision != Decision::kMatched;
+  }
+  if (summary.observations == 0) {
+    summary.message = "second registration pass: nothing left undecided";
+    return summary;
+  }
+  std::map<std::pair<int64_t, int64_t>, std::set<int64_t>> bands_of;
+  const MatchResult second =
+      MatchOnAdjustedTrajectory(survey, folder, options, rematch, &bands_of);
+  if (!second.summary.IsUsable()) {
+    summary.message =
+        "second registration pass failed: " + second.summary.message;
+    return summary;
+  }
+  // What the first pass matched must come out the same.
+  summary.disagreements = Disagreements(matches, second.matches);
+  if (summary.disagreements > 0) {
+    summary.message =
+        "second registration pass not used: with the adjusted trajectory " +
+        std::to_string(summary.disagreements) +
+        " vertex matches of the first pass come out differently";
+    LOG(WARNING) << summary.message;
+    return summary;
+  }
+  const std::vector<CrossingDecision> merged =
+      MergeSecondPass(first, second, bands_of, rematch, &matches, &summary);
+  std::ostringstream message;
+  message << "second registration pass with the adjusted trajectory: "
+          << summary.added << " of " << summary.observations
+          << " undecided observations matched";
+  summary.message = message.str();
+  if (summary.added == 0) return summary;
+  std::sort(matches.begin(), matches.end(),
+            [](const VertexMatch& a, const VertexMatch& b) {
+              return std::tie(a.exposure_id, a.band_id, a.vertex) <
+                     std::tie(b.exposure_id, b.band_id, b.vertex);
+            });
+  const std::vector<std::string> comments = {"zebrageo run: " +
+                                             summary.message};
+  WriteMatches(matches, comments, (folder / kMatchesFile).string());
+  WriteCrossingDecisions(merged, comments,
+                         (folder / kCrossingDecisionsFile).string());
+  return summary;
+}
+
+}  // namespace zebrageo
