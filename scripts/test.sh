@@ -24,6 +24,11 @@ ctest --test-dir "$here/build" --output-on-failure -j "$jobs" "${sweep[@]}"
 # false maybe-uninitialized warnings inside Eigen.
 "$here/scripts/setup.sh"
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$here}"
+# -g1: by default ccache hashes the working directory of a compilation with
+# debug info, so every fresh clone would rebuild the sanitizer trees cold
+# (about 25 minutes on 2 cores); the paths in the debug info are relative
+# to the clone anyway (CCACHE_BASEDIR).
+export CCACHE_NOHASHDIR=1
 sanitizer_build() {  # sanitizer_build DIR TARGET CMAKE-ARGS...
   local dir="$1" target="$2"
   shift 2
