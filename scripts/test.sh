@@ -26,8 +26,9 @@ ctest --test-dir "$here/build" --output-on-failure -j "$jobs" "${sweep[@]}"
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$here}"
 # -g1: by default ccache hashes the working directory of a compilation with
 # debug info, so every fresh clone would rebuild the sanitizer trees cold
-# (about 25 minutes on 2 cores); the paths in the debug info are relative
-# to the clone anyway (CCACHE_BASEDIR).
+# (about 25 minutes on 2 cores). The source paths stay relative to the
+# clone (CCACHE_BASEDIR); only the debug info's build folder may name
+# another clone's, which the sanitizers' reports do not use.
 export CCACHE_NOHASHDIR=1
 sanitizer_build() {  # sanitizer_build DIR TARGET CMAKE-ARGS...
   local dir="$1" target="$2"
