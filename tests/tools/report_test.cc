@@ -23,6 +23,61 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+bool IsNameStart(char c) {
+  return std::isalpha(static_cast<unsigned char>(c)) || c == '_' || c == ':';
+}
+bool IsNameChar(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':' ||
+         c == '.' || c == '-';
+}
+
+// The text between '<' and '>': "/name", or "name", attributes name='v' or
+// name="v" (no '<' in v), and an optional '/'. A scanner, not std::regex:
+// libstdc++'s regex recurses once per character of a polyline's points
+// and overflowed the stack under ASan.
+bool ParseTag(const std::string& tag, std::string* name, bool* closing,
+              bool* self_closing) {
+  size_t i = 0;
+  *closing = i < tag.size() && tag[i] == '/';
+  if (*closing) ++i;
+  if (i >= tag.size() || !IsNameStart(tag[i])) return false;
+  const size_t begin = i;
+  while (i < tag.size() && IsNameChar(tag[i])) ++i;
+  *name = tag.substr(begin, i - begin);
+  auto skip_space = [&] {
+    while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i])))
+      ++i;
+  };
+  if (*closing) {
+    skip_space();
+    return i == tag.size();
+  }
+  *self_closing = false;
+  while (true) {
+    const size_t before = i;
+    skip_space();
+    if (i == tag.size()) return true;
+    if (tag[i] == '/') {
+      *self_closing = true;
+      return i + 1 == tag.size();
+    }
+    if (i == before || !IsNameStart(tag[i])) return false;  // no space
+    while (i < tag.size() && IsNameChar(tag[i])) ++i;
+    skip_space();
+    if (i >= tag.size() || tag[i] != '=') return false;
+    ++i;
+    skip_space();
+    if (i >= tag.size() || (tag[i] != '\'' && tag[i] != '"')) return false;
+    const char quote = tag[i++];
+    while (i < tag.size() && tag[i] != quote) {
+      if (tag[i] == '<') return false;
+      ++i;
+    }
+    if (i >= tag.size()) return false;
+    ++i;
+  }
+}
+
 // "" when `xml` is one well-formed element (tags nested and closed, quoted
 // attributes, no bare '<' or '&' in text), else what is wrong and where.
 std::string XmlProblem(const std::string& xml) {
@@ -52,23 +107,22 @@ std::string XmlProblem(const std::string& xml) {
     if (end == std::string::npos) return where("unclosed tag");
     const std::string tag = xml.substr(at + 1, end - at - 1);
     if (tag.find('<') != std::string::npos) return where("'<' inside a tag");
-    static const std::regex close_tag(R"(^/([A-Za-z][\w:.-]*)\s*$)");
-    static const std::regex open_tag(
-        R"(^([A-Za-z][\w:.-]*)((\s+[A-Za-z_:][\w:.-]*\s*=\s*('[^'<]*'|"[^"<]*"))*)\s*(/?)$)");
-    std::smatch m;
-    if (std::regex_match(tag, m, close_tag)) {
-      if (open.empty() || open.back() != m[1].str()) {
-        return where("</" + m[1].str() + "> closes " +
+    std::string name;
+    bool closing = false, self_closing = false;
+    if (!ParseTag(tag, &name, &closing, &self_closing)) {
+      return where("malformed tag");
+    }
+    if (closing) {
+      if (open.empty() || open.back() != name) {
+        return where("</" + name + "> closes " +
                      (open.empty() ? std::string("nothing") : open.back()));
       }
       open.pop_back();
       if (open.empty() && xml.find('<', end) != std::string::npos) {
         return where("a second root element");
       }
-    } else if (std::regex_match(tag, m, open_tag)) {
-      if (m[5].str() != "/") open.push_back(m[1].str());
-    } else {
-      return where("malformed tag");
+    } else if (!self_closing) {
+      open.push_back(name);
     }
     at = end + 1;
   }
