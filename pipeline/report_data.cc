@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <set>
 
 #include "survey/input_error.h"
+#include "survey/json_file.h"
 #include "survey/results_adjustment.h"
 #include "survey/results_lines.h"
 
@@ -17,15 +17,6 @@ using nlohmann::json;
 
 bool Exists(const std::string& path) {
   return std::filesystem::is_regular_file(path);
-}
-
-json ReadJsonFile(const std::string& path, const std::string& name) {
-  std::ifstream in(path);
-  try {
-    return json::parse(in);
-  } catch (const json::exception& error) {
-    throw InputError(name, 0, std::string("malformed JSON: ") + error.what());
-  }
 }
 
 }  // namespace

@@ -1,11 +1,11 @@
 #include "survey/results_adjustment.h"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
+#include "survey/json_file.h"
 
 namespace zebrageo {
 namespace {
@@ -289,15 +289,7 @@ void WriteAdjustmentRecord(const AdjustmentRecord& record,
 
 AdjustmentRecord ReadAdjustmentRecord(const std::string& path,
                                       const std::string& display_name) {
-  std::ifstream in(path);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& error) {
-    throw InputError(display_name, 0,
-                     std::string("malformed JSON: ") + error.what());
-  }
+  const json j = ReadJsonFile(path, display_name);
   const Fields fields(j, display_name);
   AdjustmentRecord record = RecordOf(fields);
   if (j.contains("tie_points")) {

@@ -1,10 +1,9 @@
 #include "survey/results_lines.h"
 
-#include <fstream>
-
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/json_file.h"
 
 namespace zebrageo {
 namespace {
@@ -231,15 +230,7 @@ void WriteLineControl(const LineControlRecord& record,
 
 LineControlRecord ReadLineControl(const std::string& path,
                                   const std::string& display_name) {
-  std::ifstream in(path);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& error) {
-    throw InputError(display_name, 0,
-                     std::string("malformed JSON: ") + error.what());
-  }
+  const json j = ReadJsonFile(path, display_name);
   const std::string& name = display_name;
   LineControlRecord record;
   record.stretch_s = Field<double>(j, "stretch_s", name);
