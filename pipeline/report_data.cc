@@ -65,7 +65,10 @@ ReportData Collect(const ReportInputs& inputs) {
   for (const RoadmarkBand& band : survey.roadmarks.bands) {
     db_bands[{band.crossing_id, band.band}] = &band;
     for (const Geodetic& corner : band.corners) {
-      auto& sum = sums[band.crossing_id];
+      // try_emplace with an explicit zero: a value-initialised
+      // Eigen::Vector3d is not zeroed (the centres came out of garbage).
+      auto& sum = sums.try_emplace(band.crossing_id, Eigen::Vector3d::Zero(), 0)
+                      .first->second;
       sum.first += survey.frame.EnuFromGeodetic(corner);
       sum.second += 1;
     }
