@@ -77,8 +77,7 @@ AdjustmentRecord RecordOf(const AdjustmentData& data,
   for (const ControlPointResult& p : result.control_points) {
     if (p.status != ControlStatus::kRejected) continue;
     r.rejected.push_back({p.crossing_id, p.band, p.db_vertex,
-                          p.normalized_residual,
-                          p.image_enu - p.database_enu});
+                          p.normalized_residual, p.image_enu - p.database_enu});
   }
   for (size_t c = 0; c < result.T_body_cam.size(); ++c) {
     const Eigen::Isometry3d& T = result.T_body_cam[c];
@@ -260,10 +259,9 @@ AdjustmentInput AdjustmentData::Input() const {
 
 namespace {
 
-// What LoadAdjustmentData and AdjustmentDataOf share once the survey's
-// files are read: the missing images, and the stage files.
-void CompleteAdjustmentData(const std::string& results_folder,
-                            AdjustmentData* data) {
+// The images named in exposures.csv that are not on disk: counted, and a
+// warning (no tie points in them).
+void CountMissingImages(AdjustmentData* data) {
   for (const ExposureImage& image : data->exposures.images) {
     std::error_code error;
     if (!fs::is_regular_file(fs::path(data->survey_folder) / image.image,
@@ -277,11 +275,6 @@ void CompleteAdjustmentData(const std::string& results_folder,
                              std::to_string(data->exposures.images.size()) +
                              " images are missing: no tie points in them");
   }
-  data->vertices = ReadReconstructedBands(
-      RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct"),
-      kReconstructedBandsFile);
-  data->matches = ReadMatches(
-      RequiredStageFile(results_folder, kMatchesFile, "match"), kMatchesFile);
 }
 
 }  // namespace
@@ -313,12 +306,18 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
   }
   data.roadmarks = ReadSurveyRoadmarks(survey_folder, data.manifest,
                                        data.trajectory.samples());
-  CompleteAdjustmentData(results_folder, &data);
+  CountMissingImages(&data);
+  data.vertices = ReadReconstructedBands(
+      RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct"),
+      kReconstructedBandsFile);
+  data.matches = ReadMatches(
+      RequiredStageFile(results_folder, kMatchesFile, "match"), kMatchesFile);
   return data;
 }
 
 AdjustmentData AdjustmentDataOf(const Survey& survey,
-                                const std::string& results_folder) {
+                                std::vector<ReconstructedVertex> vertices,
+                                std::vector<VertexMatch> matches) {
   AdjustmentData data;
   data.survey_folder = survey.folder;
   data.manifest = survey.manifest;
@@ -327,7 +326,9 @@ AdjustmentData AdjustmentDataOf(const Survey& survey,
   data.trajectory = survey.trajectory;
   data.exposures = survey.exposures;
   data.roadmarks = survey.roadmarks;
-  CompleteAdjustmentData(results_folder, &data);
+  CountMissingImages(&data);
+  data.vertices = std::move(vertices);
+  data.matches = std::move(matches);
   return data;
 }
 
@@ -339,8 +340,8 @@ std::vector<GcpResidual> GcpResidualsOf(
     r.crossing_id = p.crossing_id;
     r.band = p.band;
     r.vertex = p.db_vertex;
-    r.role = p.status == ControlStatus::kCheck ? GcpRole::kCheck
-                                               : GcpRole::kControl;
+    r.role =
+        p.status == ControlStatus::kCheck ? GcpRole::kCheck : GcpRole::kControl;
     r.d_enu = p.adjusted_enu - p.database_enu;
     r.rms_px = p.rms_px;
     r.n_images = p.n_images;
@@ -353,11 +354,11 @@ std::vector<GcpResidual> GcpResidualsOf(
   return residuals;
 }
 
-void WriteAdjustmentResults(const AdjustmentData& data,
-                            const AdjustmentOptions& options,
-                            const AdjustmentResult& result,
-                            const TiePointSummary* tie_summary,
-                            const std::string& results_folder) {
+AdjustmentRecord WriteAdjustmentResults(const AdjustmentData& data,
+                                        const AdjustmentOptions& options,
+                                        const AdjustmentResult& result,
+                                        const TiePointSummary* tie_summary,
+                                        const std::string& results_folder) {
   fs::create_directories(results_folder);
   auto out = [&](const char* name) {
     return (fs::path(results_folder) / name).string();
@@ -387,6 +388,7 @@ void WriteAdjustmentResults(const AdjustmentData& data,
   WriteTrajectorySamples(result.corrected_samples,
                          out(kTrajectoryCorrectedFile));
   WriteCameraPoses(result.camera_poses, out(kPosesFile));
+  return record;
 }
 
 namespace {
@@ -415,26 +417,26 @@ std::vector<VertexMatch> MatchesKeptAsControl(
   return kept;
 }
 
-int RemoveRejectedMatches(const AdjustmentData& data,
-                          const AdjustmentResult& result,
-                          const std::string& results_folder) {
+int RemoveRejectedMatches(const AdjustmentResult& result,
+                          const std::string& results_folder,
+                          std::vector<VertexMatch>* matches,
+                          std::vector<CrossingDecision>* decisions) {
   const auto rejected = RejectedVertices(result);
   if (rejected.empty()) return 0;
   std::set<std::string> rejected_crossings;
   for (const auto& vertex : rejected) {
     rejected_crossings.insert(std::get<0>(vertex));
   }
-  const std::vector<VertexMatch> kept =
-      MatchesKeptAsControl(data.matches, result);
+  std::vector<VertexMatch> kept = MatchesKeptAsControl(*matches, result);
   std::map<int64_t, int> kept_per_exposure;
   for (const VertexMatch& m : kept) ++kept_per_exposure[m.exposure_id];
   std::set<int64_t> touched;
-  for (const VertexMatch& m : data.matches) {
+  for (const VertexMatch& m : *matches) {
     if (rejected.count({m.crossing_id, m.band, m.db_vertex})) {
       touched.insert(m.exposure_id);
     }
   }
-  const int removed = static_cast<int>(data.matches.size() - kept.size());
+  const int removed = static_cast<int>(matches->size() - kept.size());
   if (removed == 0) return 0;
   const fs::path folder(results_folder);
   std::string names;
@@ -446,26 +448,25 @@ int RemoveRejectedMatches(const AdjustmentData& data,
                 " vertex matches the adjustment rejected (crossings " + names +
                 "; gcp_residuals.csv, report.json warnings)"},
                (folder / kMatchesFile).string());
-  const fs::path decisions_path = folder / kCrossingDecisionsFile;
-  if (fs::exists(decisions_path)) {
-    std::vector<CrossingDecision> decisions =
-        ReadCrossingDecisions(decisions_path.string(), kCrossingDecisionsFile);
-    for (CrossingDecision& d : decisions) {
-      if (d.decision != Decision::kMatched || !touched.count(d.exposure_id) ||
-          kept_per_exposure.count(d.exposure_id)) {
-        continue;
-      }
-      d.reason = "matched to " + d.crossing_id +
-                 ", then rejected by the adjustment: inconsistent with the "
-                 "other crossings and the trajectory (report.json warnings); "
-                 "was: " +
-                 d.reason;
-      d.decision = Decision::kRefused;
-      d.crossing_id.clear();
+  *matches = std::move(kept);
+  // Without decisions (results of an older version) there is nothing to
+  // rewrite.
+  if (decisions->empty()) return removed;
+  for (CrossingDecision& d : *decisions) {
+    if (d.decision != Decision::kMatched || !touched.count(d.exposure_id) ||
+        kept_per_exposure.count(d.exposure_id)) {
+      continue;
     }
-    WriteCrossingDecisions(decisions, {"zebrageo match, then adjust"},
-                           decisions_path.string());
+    d.reason = "matched to " + d.crossing_id +
+               ", then rejected by the adjustment: inconsistent with the "
+               "other crossings and the trajectory (report.json warnings); "
+               "was: " +
+               d.reason;
+    d.decision = Decision::kRefused;
+    d.crossing_id.clear();
   }
+  WriteCrossingDecisions(*decisions, {"zebrageo match, then adjust"},
+                         (folder / kCrossingDecisionsFile).string());
   return removed;
 }
 

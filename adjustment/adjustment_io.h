@@ -60,18 +60,21 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
                                   const std::string& results_folder,
                                   const SurveyPathOptions& paths = {});
 // The same from a survey already loaded (LoadSurvey reads its files as
-// LoadAdjustmentData does): only the stage files are read.
+// LoadAdjustmentData does) and the stage outputs in memory (what
+// reconstructed_bands.csv and matches.csv hold).
 AdjustmentData AdjustmentDataOf(const Survey& survey,
-                                const std::string& results_folder);
+                                std::vector<ReconstructedVertex> vertices,
+                                std::vector<VertexMatch> matches);
 
 // Writes every output listed above into `results_folder` (created if
 // needed). `tie_summary` may be null (no tie points). Throws
-// std::runtime_error when a file cannot be written.
-void WriteAdjustmentResults(const AdjustmentData& data,
-                            const AdjustmentOptions& options,
-                            const AdjustmentResult& result,
-                            const TiePointSummary* tie_summary,
-                            const std::string& results_folder);
+// std::runtime_error when a file cannot be written. Returns what
+// adjustment.json holds.
+AdjustmentRecord WriteAdjustmentResults(const AdjustmentData& data,
+                                        const AdjustmentOptions& options,
+                                        const AdjustmentResult& result,
+                                        const TiePointSummary* tie_summary,
+                                        const std::string& results_folder);
 
 // The vertex matches of `matches` that the adjustment did not reject: what
 // matches.csv keeps (below), and what a user's control is made of.
@@ -85,9 +88,12 @@ std::vector<VertexMatch> MatchesKeptAsControl(
 // crossing_decisions.csv, with the reason. Both rewritten atomically, only
 // when something was rejected. Returns the number of vertex matches
 // removed.
-int RemoveRejectedMatches(const AdjustmentData& data,
-                          const AdjustmentResult& result,
-                          const std::string& results_folder);
+// *matches and *decisions (the stage outputs in memory; decisions empty:
+// none to rewrite) are updated as the files.
+int RemoveRejectedMatches(const AdjustmentResult& result,
+                          const std::string& results_folder,
+                          std::vector<VertexMatch>* matches,
+                          std::vector<CrossingDecision>* decisions);
 
 // The gcp_residuals.csv rows of `points` (survey/results.h writes them).
 std::vector<GcpResidual> GcpResidualsOf(

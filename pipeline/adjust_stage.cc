@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <set>
+#include <utility>
 
 #include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
@@ -19,15 +20,10 @@ namespace zebrageo {
 namespace {
 
 // Exposures the reconstruction skipped (their images could not be read):
-// they get no pose (SURVEY_FORMAT.md). Empty without skipped_exposures.csv
-// (results of an older version).
-std::set<int64_t> SkippedExposureIds(const std::string& results_folder) {
+// they get no pose (SURVEY_FORMAT.md).
+std::set<int64_t> SkippedExposureIds(StageResults* results) {
   std::set<int64_t> ids;
-  const std::string path =
-      (std::filesystem::path(results_folder) / kSkippedExposuresFile).string();
-  if (!std::filesystem::exists(path)) return ids;
-  for (const SkippedExposure& s :
-       ReadSkippedExposures(path, kSkippedExposuresFile)) {
+  for (const SkippedExposure& s : results->SkippedExposures()) {
     ids.insert(s.exposure_id);
   }
   return ids;
@@ -36,12 +32,14 @@ std::set<int64_t> SkippedExposureIds(const std::string& results_folder) {
 }  // namespace
 
 std::vector<std::string> RunAdjustStage(const Survey& survey,
-                                        const std::string& results_folder,
+                                        StageResults* results,
                                         const AdjustmentOptions& options,
                                         bool tie_points, bool lines,
                                         const ProgressListener& progress) {
-  // The survey as loaded (not read again), with the stages' files.
-  AdjustmentData data = AdjustmentDataOf(survey, results_folder);
+  const std::string& results_folder = results->folder();
+  // The survey as loaded (not read again), with the stages' outputs.
+  AdjustmentData data =
+      AdjustmentDataOf(survey, results->Vertices(), results->Matches());
   // The survey's warnings first: adjustment.json and the adjust command's
   // report.json list them too.
   data.warnings.insert(data.warnings.begin(), survey.warnings.begin(),
@@ -70,8 +68,9 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
   step.Finish();
   std::vector<std::string> warnings = data.warnings;
   if (lines && result.summary.IsUsable()) {
-    const std::vector<LineControlPoint> line_points = MatchLinesForAdjustment(
-        data, options, result, results_folder, &warnings);
+    const std::vector<LineControlPoint> line_points =
+        MatchLinesForAdjustment(data, options, result, results->LinePoints(),
+                                results_folder, &warnings);
     if (!line_points.empty()) {
       input.line_points = &line_points;
       StepProgress line_step(progress, "adjust with lines");
@@ -90,7 +89,7 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
     throw StageFailedError("adjust: " + result.summary.message +
                            "; no results were written" + context);
   }
-  const std::set<int64_t> skipped = SkippedExposureIds(results_folder);
+  const std::set<int64_t> skipped = SkippedExposureIds(results);
   result.camera_poses.erase(
       std::remove_if(result.camera_poses.begin(), result.camera_poses.end(),
                      [&skipped](const CameraPose& pose) {
@@ -98,9 +97,15 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
                      }),
       result.camera_poses.end());
   RemoveStaleTemporaries(results_folder);
-  WriteAdjustmentResults(data, options, result,
-                         use_ties ? &tie_summary : nullptr, results_folder);
-  const int removed = RemoveRejectedMatches(data, result, results_folder);
+  AdjustmentRecord record = WriteAdjustmentResults(
+      data, options, result, use_ties ? &tie_summary : nullptr, results_folder);
+  std::vector<VertexMatch> matches = std::move(data.matches);
+  std::vector<CrossingDecision> decisions = results->Decisions();
+  const int removed =
+      RemoveRejectedMatches(result, results_folder, &matches, &decisions);
+  results->SetMatches(std::move(matches), std::move(decisions));
+  results->SetAdjustment(std::move(result.corrected_samples),
+                         std::move(record));
   if (removed > 0) {
     LOG(INFO) << "adjust: " << removed
               << " vertex matches rejected by the adjustment removed from "

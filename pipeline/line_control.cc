@@ -28,8 +28,9 @@ namespace {
 // point follows it when the adjustment moves the point along the line.
 constexpr double kGradeHalfWindowM = 10.0;
 
-// The corrected body pose at `time` (linear in position, slerp in
-// attitude between the corrected samples); false outside them.
+// The corrected body pose at `time` (InterpolatePoses, as Trajectory does:
+// linear in position, slerp in attitude between the corrected samples);
+// false outside them.
 bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
   const auto& samples = result.corrected_samples;
   if (samples.size() < 2 || time < samples.front().time ||
@@ -43,10 +44,8 @@ bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
       std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
   const double span = samples[i + 1].time - samples[i].time;
   const double u = span > 0.0 ? (time - samples[i].time) / span : 0.0;
-  const Pose& a = result.corrected_poses[i];
-  const Pose& b = result.corrected_poses[i + 1];
-  pose->p_enu = (1.0 - u) * a.p_enu + u * b.p_enu;
-  pose->q_enu_body = a.q_enu_body.slerp(u, b.q_enu_body);
+  *pose = InterpolatePoses(result.corrected_poses[i],
+                           result.corrected_poses[i + 1], u);
   return true;
 }
 
@@ -198,20 +197,17 @@ void LogLineControl(size_t used, size_t reconstructed, double stretch_s,
 
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
-    const AdjustmentResult& zebra_result, const std::string& results_folder,
-    std::vector<std::string>* warnings) {
+    const AdjustmentResult& zebra_result,
+    const std::vector<ReconstructedLinePoint>* reconstructed_lines,
+    const std::string& results_folder, std::vector<std::string>* warnings) {
   std::vector<LineControlPoint> control;
-  const std::string path =
-      (std::filesystem::path(results_folder) / kReconstructedLinesFile)
-          .string();
-  if (!std::filesystem::exists(path)) return control;
+  if (reconstructed_lines == nullptr) return control;
   if (data.roadmarks.lines.empty()) {
     warnings->push_back(
         "the road-mark database has no lines: road lines not used");
     return control;
   }
-  const std::vector<ReconstructedLinePoint> points =
-      ReadReconstructedLines(path, kReconstructedLinesFile);
+  const std::vector<ReconstructedLinePoint>& points = *reconstructed_lines;
   std::unordered_map<int64_t, double> exposure_time;
   for (const Exposure& e : data.exposures.exposures) {
     exposure_time[e.exposure_id] = e.time;

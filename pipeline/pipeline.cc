@@ -4,9 +4,11 @@
 #include <sys/resource.h>
 
 #include <sstream>
+#include <utility>
 
 #include "pipeline/exit_codes.h"
 #include "pipeline/run_state.h"
+#include "pipeline/stage_results.h"
 #include "pipeline/stages.h"
 #include "registration/match_stage.h"
 #include "survey/math_util.h"
@@ -38,7 +40,7 @@ std::vector<std::string> SurveyInputFiles(const Survey& survey) {
 // reconstruct: the zebra bands, then the road lines on the road plane the
 // zebra stage estimated.
 std::vector<std::string> Reconstruct(
-    const Survey& survey, const std::string& results, const RunOptions& options,
+    const Survey& survey, StageResults* results, const RunOptions& options,
     const std::function<void(int, int)>& progress) {
   RoadPlane road_plane;
   std::vector<std::string> warnings = RunReconstructStage(
@@ -53,23 +55,43 @@ std::vector<std::string> Reconstruct(
   return warnings;
 }
 
-std::vector<std::string> Match(const Survey& survey, const std::string& results,
+std::vector<std::string> Match(const Survey& survey, StageResults* results,
                                const RunOptions& options,
                                const std::function<void(int, int)>& progress) {
-  const MatchResult result =
-      RunMatchStage(survey, results, options.matching, progress);
+  MatchResult result =
+      RunMatchStage(survey, results->Vertices(), results->folder(),
+                    options.matching, progress);
   if (!result.summary.IsUsable()) {
     throw StageFailedError("match: " + result.summary.message);
   }
   LOG(INFO) << "match: " << result.summary.BriefReport();
+  results->SetMatches(std::move(result.matches), std::move(result.decisions));
   return {};
+}
+
+// The second registration pass on what the adjustment left in `results`.
+RematchSummary Rematch(const Survey& survey, StageResults* results,
+                       const RunOptions& options) {
+  RematchInput first;
+  first.adjustment = results->Adjustment();
+  first.vertices = &results->Vertices();
+  first.matches = &results->Matches();
+  first.decisions = &results->Decisions();
+  first.adjusted_trajectory = &results->CorrectedTrajectory();
+  RematchSummary rematch = RematchWithAdjustedTrajectory(
+      survey, first, options.matching, RematchOptions());
+  WriteRematchResults(rematch, results->folder());
+  if (rematch.added > 0) {
+    results->SetMatches(std::move(rematch.matches),
+                        std::move(rematch.decisions));
+  }
+  return rematch;
 }
 
 // adjust (with road lines: line matching and a second adjustment inside
 // RunAdjustStage), then the second registration pass and, if it added
 // matches, the adjustment again.
-std::vector<std::string> Adjust(const Survey& survey,
-                                const std::string& results,
+std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
                                 const RunOptions& options,
                                 const ProgressListener& progress) {
   std::vector<std::string> warnings =
@@ -78,15 +100,14 @@ std::vector<std::string> Adjust(const Survey& survey,
   if (!options.rematch) return warnings;
   // Crossings the first pass could not decide, matched again with the
   // adjusted trajectory.
-  const RematchSummary rematch = RematchWithAdjustedTrajectory(
-      survey, results, options.matching, RematchOptions());
+  const RematchSummary rematch = Rematch(survey, results, options);
   LOG(INFO) << rematch.message;
   // Refused for contradicting the first pass: logged as a warning, so
   // listed in report.json too.
   if (rematch.disagreements > 0) warnings.push_back(rematch.message);
   if (rematch.added == 0) {
     // The rematch rewrote matches.csv: its output_crs columns again.
-    AddOutputCrs(survey, results);
+    AddOutputCrs(survey, results->folder());
     return warnings;
   }
   return RunAdjustStage(survey, results, options.adjustment, options.tie_points,
@@ -112,7 +133,10 @@ RunSummary RunSurveyPipeline(const Survey& survey,
                              const ProgressListener& progress) {
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError(problem);
-  const std::string& results = results_folder;
+  // The stage outputs, handed from stage to stage in memory; what a
+  // resumed run skips is read from the folder on first use.
+  StageResults stage_results(results_folder);
+  StageResults* results = &stage_results;
 
   std::vector<PipelineStage> stages;
   std::vector<std::string> reconstruct_outputs = {kReconstructedBandsFile,
@@ -138,13 +162,14 @@ RunSummary RunSurveyPipeline(const Survey& survey,
            << ";lines=" << options.lines
            << ";sideslip=" << RadToDeg(options.adjustment.sideslip_sigma_rad)
            << ";rematch=" << options.rematch;
-  const PipelineRun run = RunPipeline(
-      results, InputFingerprint(SurveyInputFiles(survey), settings.str()),
-      stages, PipelineOptions{options.from_stage}, progress);
+  const PipelineRun run =
+      RunPipeline(results_folder,
+                  InputFingerprint(SurveyInputFiles(survey), settings.str()),
+                  stages, PipelineOptions{options.from_stage}, progress);
 
   ReportInputs inputs;
   inputs.survey = &survey;
-  inputs.results_folder = results;
+  inputs.results_folder = results_folder;
   inputs.timings = run.timings;
   inputs.warnings = run.warnings;
   inputs.peak_memory_mb = PeakMemoryMb();

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pipeline/exit_codes.h"
@@ -43,9 +44,9 @@ void ThrowIfTooManyUnreadable(const Survey& survey,
 
 std::vector<std::string> RunReconstructStage(
     const Survey& survey, const ReconstructionOptions& options,
-    const std::string& results_folder,
-    const std::function<void(int, int)>& progress, RoadPlane* road_plane) {
-  std::filesystem::create_directories(results_folder);
+    StageResults* results, const std::function<void(int, int)>& progress,
+    RoadPlane* road_plane) {
+  std::filesystem::create_directories(results->folder());
   std::vector<ReconstructedVertex> vertices;
   const ReconstructionSummary summary =
       ReconstructSurvey(survey, options, &vertices, progress);
@@ -73,13 +74,10 @@ std::vector<std::string> RunReconstructStage(
   for (const auto& [exposure_id, reason] : summary.skipped_exposures) {
     skipped.push_back({exposure_id, reason});
   }
-  WriteSkippedExposures(
-      skipped,
-      (std::filesystem::path(results_folder) / kSkippedExposuresFile).string());
-  WriteReconstructedBands(
-      vertices, comments,
-      (std::filesystem::path(results_folder) / kReconstructedBandsFile)
-          .string());
+  WriteSkippedExposures(skipped, results->PathOf(kSkippedExposuresFile));
+  WriteReconstructedBands(vertices, comments,
+                          results->PathOf(kReconstructedBandsFile));
+  results->SetReconstruction(std::move(vertices), std::move(skipped));
   LOG(INFO) << "reconstruct: " << summary.BriefReport() << " in "
             << summary.wall_time_s << " s";
   LOG(INFO) << "reconstruct: " << comments[1];
@@ -88,12 +86,11 @@ std::vector<std::string> RunReconstructStage(
 
 std::vector<std::string> RunRoadLinesStage(
     const Survey& survey, const RoadPlane& road_plane,
-    const RoadLineOptions& options, int threads,
-    const std::string& results_folder,
+    const RoadLineOptions& options, int threads, StageResults* results,
     const std::function<void(int, int)>& progress) {
   const std::string error = options.Check();
   if (!error.empty()) throw StageFailedError(error);
-  std::filesystem::create_directories(results_folder);
+  std::filesystem::create_directories(results->folder());
   std::vector<ReconstructedLinePoint> points;
   const RoadLineSummary summary = ExtractSurveyLines(
       survey, road_plane, options, threads, &points, progress);
@@ -101,8 +98,8 @@ std::vector<std::string> RunRoadLinesStage(
   if (summary.lines == 0) warnings.push_back("no road line was reconstructed");
   WriteReconstructedLines(
       points, {"zebrageo reconstruct --lines: " + summary.BriefReport()},
-      (std::filesystem::path(results_folder) / kReconstructedLinesFile)
-          .string());
+      results->PathOf(kReconstructedLinesFile));
+  results->SetLinePoints(std::move(points));
   LOG(INFO) << "road lines: " << summary.BriefReport();
   return warnings;
 }

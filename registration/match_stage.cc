@@ -360,8 +360,16 @@ MatchResult RunMatchStage(const Survey& survey,
         kReconstructedBandsFile, 0,
         "missing in " + results_folder + " (run `zebrageo reconstruct` first)");
   }
-  const std::vector<ReconstructedVertex> vertices =
-      ReadReconstructedBands(input_path, kReconstructedBandsFile);
+  return RunMatchStage(
+      survey, ReadReconstructedBands(input_path, kReconstructedBandsFile),
+      results_folder, options, progress);
+}
+
+MatchResult RunMatchStage(const Survey& survey,
+                          const std::vector<ReconstructedVertex>& vertices,
+                          const std::string& results_folder,
+                          const MatchOptions& options,
+                          const std::function<void(int, int)>& progress) {
   int incomplete = 0;
   MatchInput input;
   input.observations =

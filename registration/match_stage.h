@@ -21,6 +21,7 @@
 #include "registration/band_matcher.h"
 #include "registration/roadmark_index.h"
 #include "survey/results.h"
+#include "survey/results_adjustment.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
@@ -48,9 +49,17 @@ void WriteMatchEvidence(const MatchResult& result, const MatchOptions& options,
 void WriteMatchesGeoJson(const MatchInput& input, const MatchResult& result,
                          const LocalFrame& frame, const std::string& path);
 
-// The whole stage. Throws InputError for unreadable or inconsistent
-// inputs (a missing reconstructed_bands.csv included). The result's summary
-// says whether the matcher ran (IsUsable).
+// The whole stage on the reconstruction's bands (what
+// reconstructed_bands.csv holds), writing its files into results_folder.
+// Throws InputError for inconsistent inputs. The result's summary says
+// whether the matcher ran (IsUsable).
+MatchResult RunMatchStage(const Survey& survey,
+                          const std::vector<ReconstructedVertex>& vertices,
+                          const std::string& results_folder,
+                          const MatchOptions& options,
+                          const std::function<void(int, int)>& progress = {});
+// The same with the bands read from results_folder/reconstructed_bands.csv
+// (InputError when missing or unreadable).
 MatchResult RunMatchStage(const Survey& survey,
                           const std::string& results_folder,
                           const MatchOptions& options,
@@ -83,9 +92,32 @@ struct RematchSummary {
   int added = 0;          // matched now
   int disagreements = 0;  // first-pass matches the second pass contradicts
   std::string message;    // one line for the log and the report
+  // When added > 0: what matches.csv and crossing_decisions.csv now hold.
+  std::vector<VertexMatch> matches;
+  std::vector<CrossingDecision> decisions;
 };
-// Rewrites matches.csv and crossing_decisions.csv (atomically) when it adds
-// matches. Throws InputError for unreadable inputs.
+// What the second pass works on: the first pass's outputs as the
+// adjustment left them, and the adjustment's. Pointers, none owned.
+struct RematchInput {
+  const std::vector<ReconstructedVertex>* vertices = nullptr;
+  const std::vector<VertexMatch>* matches = nullptr;
+  const std::vector<CrossingDecision>* decisions = nullptr;
+  const std::vector<TrajectorySample>* adjusted_trajectory = nullptr;
+  // adjustment.json's record; null: none (the pass is skipped, and
+  // nothing else is read).
+  const AdjustmentRecord* adjustment = nullptr;
+};
+// Writes nothing (WriteRematchResults does).
+RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
+                                             const RematchInput& first,
+                                             const MatchOptions& options,
+                                             const RematchOptions& rematch);
+// When the pass added matches: matches.csv and crossing_decisions.csv
+// rewritten with them (atomically).
+void WriteRematchResults(const RematchSummary& summary,
+                         const std::string& results_folder);
+// The same from the files of results_folder, and the files rewritten.
+// Throws InputError for unreadable inputs.
 RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
                                              const std::string& results_folder,
                                              const MatchOptions& options,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -41,25 +42,18 @@ std::string RematchOptions::Check() const {
 
 namespace {
 
-// "" when the adjustment (its adjustment.json, survey/results_adjustment.h)
-// can gate the second pass, else why not.
-std::string AdjustmentUnfitForRematch(const std::string& results_folder,
+// "" when the adjustment (its adjustment.json, survey/results_adjustment.h,
+// null when missing) can gate the second pass, else why not.
+std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
                                       int min_control_crossings) {
-  const fs::path path = fs::path(results_folder) / kAdjustmentJsonFile;
-  if (!fs::exists(path)) {
+  if (record == nullptr) {
     return std::string(kAdjustmentJsonFile) + " is missing";
   }
-  AdjustmentRecord record;
-  try {
-    record = ReadAdjustmentRecord(path.string(), kAdjustmentJsonFile);
-  } catch (const InputError&) {
-    return std::string(kAdjustmentJsonFile) + " is not readable JSON";
-  }
-  if (!record.posterior_sd_computed) {
+  if (!record->posterior_sd_computed) {
     return "the adjustment has no posterior covariance to gate it";
   }
   const int crossings =
-      record.counts.control_crossings + record.counts.check_crossings;
+      record->counts.control_crossings + record->counts.check_crossings;
   if (crossings < min_control_crossings) {
     return "the adjustment has " + std::to_string(crossings) +
            " control crossings (" + std::to_string(min_control_crossings) +
@@ -72,16 +66,12 @@ std::string AdjustmentUnfitForRematch(const std::string& results_folder,
 // left it (its corrected trajectory), with the rematch gates. *bands_of:
 // the band ids of each observation (exposure, group).
 MatchResult MatchOnAdjustedTrajectory(
-    const Survey& survey, const fs::path& folder, const MatchOptions& options,
-    const RematchOptions& rematch,
+    const Survey& survey, const RematchInput& first,
+    const MatchOptions& options, const RematchOptions& rematch,
     std::map<std::pair<int64_t, int64_t>, std::set<int64_t>>* bands_of) {
   Survey adjusted = survey;
-  adjusted.trajectory = Trajectory(
-      ReadTrajectorySamples((folder / kTrajectoryCorrectedFile).string(),
-                            kTrajectoryCorrectedFile),
-      survey.frame);
-  const std::vector<ReconstructedVertex> vertices = ReadReconstructedBands(
-      (folder / kReconstructedBandsFile).string(), kReconstructedBandsFile);
+  adjusted.trajectory = Trajectory(*first.adjusted_trajectory, survey.frame);
+  const std::vector<ReconstructedVertex>& vertices = *first.vertices;
   MatchInput input;
   input.observations =
       BuildObservations(adjusted, vertices, kReconstructedBandsFile, nullptr);
@@ -168,22 +158,18 @@ std::vector<CrossingDecision> MergeSecondPass(
 }  // namespace
 
 RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
-                                             const std::string& results_folder,
+                                             const RematchInput& first,
                                              const MatchOptions& options,
                                              const RematchOptions& rematch) {
   RematchSummary summary;
-  const fs::path folder(results_folder);
-  const std::string unfit =
-      AdjustmentUnfitForRematch(results_folder, rematch.min_control_crossings);
+  const std::string unfit = AdjustmentUnfitForRematch(
+      first.adjustment, rematch.min_control_crossings);
   if (!unfit.empty()) {
     summary.message = "second registration pass skipped: " + unfit;
     return summary;
   }
-  const std::vector<CrossingDecision> first = ReadCrossingDecisions(
-      (folder / kCrossingDecisionsFile).string(), kCrossingDecisionsFile);
-  std::vector<VertexMatch> matches =
-      ReadMatches((folder / kMatchesFile).string(), kMatchesFile);
-  for (const CrossingDecision& d : first) {
+  std::vector<VertexMatch> matches = *first.matches;
+  for (const CrossingDecision& d : *first.decisions) {
     summary.observations += d.decision != Decision::kMatched;
   }
   if (summary.observations == 0) {
@@ -192,7 +178,7 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
   }
   std::map<std::pair<int64_t, int64_t>, std::set<int64_t>> bands_of;
   const MatchResult second =
-      MatchOnAdjustedTrajectory(survey, folder, options, rematch, &bands_of);
+      MatchOnAdjustedTrajectory(survey, first, options, rematch, &bands_of);
   if (!second.summary.IsUsable()) {
     summary.message =
         "second registration pass failed: " + second.summary.message;
@@ -208,8 +194,8 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
     LOG(WARNING) << summary.message;
     return summary;
   }
-  const std::vector<CrossingDecision> merged =
-      MergeSecondPass(first, second, bands_of, rematch, &matches, &summary);
+  std::vector<CrossingDecision> merged = MergeSecondPass(
+      *first.decisions, second, bands_of, rematch, &matches, &summary);
   std::ostringstream message;
   message << "second registration pass with the adjusted trajectory: "
           << summary.added << " of " << summary.observations
@@ -221,11 +207,72 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
               return std::tie(a.exposure_id, a.band_id, a.vertex) <
                      std::tie(b.exposure_id, b.band_id, b.vertex);
             });
+  summary.matches = std::move(matches);
+  summary.decisions = std::move(merged);
+  return summary;
+}
+
+void WriteRematchResults(const RematchSummary& summary,
+                         const std::string& results_folder) {
+  if (summary.added == 0) return;
   const std::vector<std::string> comments = {"zebrageo run: " +
                                              summary.message};
-  WriteMatches(matches, comments, (folder / kMatchesFile).string());
-  WriteCrossingDecisions(merged, comments,
+  const fs::path folder(results_folder);
+  WriteMatches(summary.matches, comments, (folder / kMatchesFile).string());
+  WriteCrossingDecisions(summary.decisions, comments,
                          (folder / kCrossingDecisionsFile).string());
+}
+
+RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
+                                             const std::string& results_folder,
+                                             const MatchOptions& options,
+                                             const RematchOptions& rematch) {
+  const fs::path folder(results_folder);
+  // adjustment.json first: without it (or unreadable) nothing else is read.
+  std::optional<AdjustmentRecord> record;
+  const fs::path record_path = folder / kAdjustmentJsonFile;
+  if (fs::exists(record_path)) {
+    try {
+      record = ReadAdjustmentRecord(record_path.string(), kAdjustmentJsonFile);
+    } catch (const InputError&) {
+      RematchSummary summary;
+      summary.message = std::string("second registration pass skipped: ") +
+                        kAdjustmentJsonFile + " is not readable JSON";
+      return summary;
+    }
+  }
+  RematchInput first;
+  first.adjustment = record ? &*record : nullptr;
+  if (!AdjustmentUnfitForRematch(first.adjustment,
+                                 rematch.min_control_crossings)
+           .empty()) {
+    return RematchWithAdjustedTrajectory(survey, first, options, rematch);
+  }
+  const std::vector<CrossingDecision> decisions = ReadCrossingDecisions(
+      (folder / kCrossingDecisionsFile).string(), kCrossingDecisionsFile);
+  const std::vector<VertexMatch> matches =
+      ReadMatches((folder / kMatchesFile).string(), kMatchesFile);
+  first.decisions = &decisions;
+  first.matches = &matches;
+  // The corrected trajectory and the bands only when something is left
+  // undecided (RematchWithAdjustedTrajectory returns before using them).
+  std::vector<TrajectorySample> adjusted;
+  std::vector<ReconstructedVertex> vertices;
+  const bool undecided = std::any_of(decisions.begin(), decisions.end(),
+                                     [](const CrossingDecision& d) {
+                                       return d.decision != Decision::kMatched;
+                                     });
+  if (undecided) {
+    adjusted = ReadTrajectorySamples(
+        (folder / kTrajectoryCorrectedFile).string(), kTrajectoryCorrectedFile);
+    vertices = ReadReconstructedBands(
+        (folder / kReconstructedBandsFile).string(), kReconstructedBandsFile);
+  }
+  first.adjusted_trajectory = &adjusted;
+  first.vertices = &vertices;
+  const RematchSummary summary =
+      RematchWithAdjustedTrajectory(survey, first, options, rematch);
+  WriteRematchResults(summary, results_folder);
   return summary;
 }
 

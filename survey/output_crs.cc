@@ -15,6 +15,7 @@
 #include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/json_file.h"
 #include "survey/results.h"
 
 namespace zebrageo {
@@ -139,13 +140,9 @@ struct CrsWriter {
 
   // bands.geojson with its coordinates in the output CRS and a "crs" member.
   void RewriteBands(const std::string& path) const {
-    nlohmann::json collection;
-    try {
-      collection = nlohmann::json::parse(ReadText(path));
-    } catch (const nlohmann::json::exception& error) {
-      throw InputError(kBandsGeoJsonFile, 0,
-                       std::string("malformed JSON: ") + error.what());
-    }
+    // The features' properties are kept as written: the JSON itself, with
+    // the contract's reader for the corners.
+    nlohmann::json collection = ReadJsonFile(path, kBandsGeoJsonFile);
     if (collection.contains("crs")) return;  // already in the output CRS
     const std::vector<AdjustedBand> bands =
         ReadAdjustedBands(path, kBandsGeoJsonFile);

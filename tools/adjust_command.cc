@@ -40,8 +40,9 @@ void RunAdjust(const AdjustArguments& args) {
   load_options.require_images = false;
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
   session.Open();
-  RunAdjustStage(survey, args.stage.results, options, args.tie_points,
-                 args.lines, ProgressBars());
+  StageResults results(args.stage.results);
+  RunAdjustStage(survey, &results, options, args.tie_points, args.lines,
+                 ProgressBars());
   session.Succeeded();
 }
 

@@ -51,13 +51,13 @@ void RunReconstruct(const ReconstructArguments& args) {
   session.Open();
   ProgressBar bar("reconstruct");
   RoadPlane road_plane;
-  RunReconstructStage(survey, options, args.stage.results, bar.Callback(),
-                      &road_plane);
+  StageResults results(args.stage.results);
+  RunReconstructStage(survey, options, &results, bar.Callback(), &road_plane);
   bar.Finish();
   if (args.lines) {
     ProgressBar lines_bar("road lines");
     RunRoadLinesStage(survey, road_plane, RoadLineOptions(), args.threads,
-                      args.stage.results, lines_bar.Callback());
+                      &results, lines_bar.Callback());
     lines_bar.Finish();
   }
   session.Succeeded();

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -67,7 +68,7 @@ class MatchLinesForAdjustmentTest : public ::testing::Test {
       zebra_.corrected_poses.push_back(TruePose(sample.time));
     }
     // One exposure every 0.5 s; each sees every line from 4 to 12 m ahead.
-    std::vector<ReconstructedLinePoint> points;
+    std::vector<ReconstructedLinePoint>& points = points_;
     int64_t line_id = 0;
     for (int e = 0; e < 40; ++e) {
       Exposure exposure;
@@ -92,14 +93,13 @@ class MatchLinesForAdjustmentTest : public ::testing::Test {
         }
       }
     }
-    WriteReconstructedLines(points, {"test"},
-                            folder_.Path(kReconstructedLinesFile));
     points_per_line_ = 40 * 5;
   }
 
   std::vector<PaintedLine> lines_;
   AdjustmentData data_;
   AdjustmentResult zebra_;
+  std::vector<ReconstructedLinePoint> points_;
   TemporaryFolder folder_;
   int points_per_line_ = 0;
 };
@@ -107,7 +107,7 @@ class MatchLinesForAdjustmentTest : public ::testing::Test {
 TEST_F(MatchLinesForAdjustmentTest, ControlLiesOnThePaintAndTheStaleLineIsOut) {
   std::vector<std::string> warnings;
   const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, folder_.Path(), &warnings);
+      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
 
   // Nearly every point of the three true lines is control (the database
   // lines are long enough for all of them).
@@ -145,19 +145,19 @@ TEST_F(MatchLinesForAdjustmentTest, ControlLiesOnThePaintAndTheStaleLineIsOut) {
 }
 
 TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
-  TemporaryFolder empty;
   std::vector<std::string> warnings;
   EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
-                                      empty.Path(), &warnings)
+                                      nullptr, folder_.Path(), &warnings)
                   .empty());
   EXPECT_TRUE(warnings.empty());
+  EXPECT_FALSE(std::filesystem::exists(folder_.Path(kLineMatchesFile)));
 }
 
 TEST_F(MatchLinesForAdjustmentTest, ADatabaseWithoutLinesIsAWarning) {
   data_.roadmarks.lines.clear();
   std::vector<std::string> warnings;
   EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
-                                      folder_.Path(), &warnings)
+                                      &points_, folder_.Path(), &warnings)
                   .empty());
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_THAT(warnings[0], HasSubstr("no lines"));
