@@ -418,16 +418,20 @@ std::vector<VertexMatch> MatchesKeptAsControl(
 }
 
 int RemoveRejectedMatches(const AdjustmentResult& result,
-                          const std::string& results_folder,
                           std::vector<VertexMatch>* matches,
-                          std::vector<CrossingDecision>* decisions) {
+                          std::vector<CrossingDecision>* decisions,
+                          std::string* rejected_crossings) {
   const auto rejected = RejectedVertices(result);
   if (rejected.empty()) return 0;
-  std::set<std::string> rejected_crossings;
-  for (const auto& vertex : rejected) {
-    rejected_crossings.insert(std::get<0>(vertex));
-  }
   std::vector<VertexMatch> kept = MatchesKeptAsControl(*matches, result);
+  const int removed = static_cast<int>(matches->size() - kept.size());
+  if (removed == 0) return 0;
+  std::set<std::string> crossings;
+  for (const auto& vertex : rejected) crossings.insert(std::get<0>(vertex));
+  rejected_crossings->clear();
+  for (const std::string& id : crossings) {
+    *rejected_crossings += (rejected_crossings->empty() ? "" : " ") + id;
+  }
   std::map<int64_t, int> kept_per_exposure;
   for (const VertexMatch& m : kept) ++kept_per_exposure[m.exposure_id];
   std::set<int64_t> touched;
@@ -436,22 +440,7 @@ int RemoveRejectedMatches(const AdjustmentResult& result,
       touched.insert(m.exposure_id);
     }
   }
-  const int removed = static_cast<int>(matches->size() - kept.size());
-  if (removed == 0) return 0;
-  const fs::path folder(results_folder);
-  std::string names;
-  for (const std::string& id : rejected_crossings) {
-    names += (names.empty() ? "" : " ") + id;
-  }
-  WriteMatches(kept,
-               {"zebrageo adjust removed " + std::to_string(removed) +
-                " vertex matches the adjustment rejected (crossings " + names +
-                "; gcp_residuals.csv, report.json warnings)"},
-               (folder / kMatchesFile).string());
   *matches = std::move(kept);
-  // Without decisions (results of an older version) there is nothing to
-  // rewrite.
-  if (decisions->empty()) return removed;
   for (CrossingDecision& d : *decisions) {
     if (d.decision != Decision::kMatched || !touched.count(d.exposure_id) ||
         kept_per_exposure.count(d.exposure_id)) {
@@ -465,6 +454,26 @@ int RemoveRejectedMatches(const AdjustmentResult& result,
     d.decision = Decision::kRefused;
     d.crossing_id.clear();
   }
+  return removed;
+}
+
+int RemoveRejectedMatches(const AdjustmentResult& result,
+                          const std::string& results_folder,
+                          std::vector<VertexMatch>* matches,
+                          std::vector<CrossingDecision>* decisions) {
+  std::string crossings;
+  const int removed =
+      RemoveRejectedMatches(result, matches, decisions, &crossings);
+  if (removed == 0) return 0;
+  const fs::path folder(results_folder);
+  WriteMatches(*matches,
+               {"zebrageo adjust removed " + std::to_string(removed) +
+                " vertex matches the adjustment rejected (crossings " +
+                crossings + "; gcp_residuals.csv, report.json warnings)"},
+               (folder / kMatchesFile).string());
+  // Without decisions (results of an older version) there is nothing to
+  // rewrite.
+  if (decisions->empty()) return removed;
   WriteCrossingDecisions(*decisions, {"zebrageo match, then adjust"},
                          (folder / kCrossingDecisionsFile).string());
   return removed;

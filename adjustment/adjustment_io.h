@@ -94,6 +94,11 @@ int RemoveRejectedMatches(const AdjustmentResult& result,
                           const std::string& results_folder,
                           std::vector<VertexMatch>* matches,
                           std::vector<CrossingDecision>* decisions);
+// The same in memory only; *rejected_crossings: their ids, space-separated.
+int RemoveRejectedMatches(const AdjustmentResult& result,
+                          std::vector<VertexMatch>* matches,
+                          std::vector<CrossingDecision>* decisions,
+                          std::string* rejected_crossings);
 
 // The gcp_residuals.csv rows of `points` (survey/results.h writes them).
 std::vector<GcpResidual> GcpResidualsOf(

@@ -22,8 +22,8 @@
 #include <glog/logging.h>
 
 #include <CLI/CLI.hpp>
-#include <cstdio>
 #include <algorithm>
+#include <cstdio>
 #include <iostream>
 #include <string>
 
@@ -71,6 +71,9 @@ int Main(int argc, char** argv) {
                  "dump this seed's survey and results to -o DIR");
   app.add_option("-o,--output", output, "folder of --verbose");
   app.add_flag("--quiet", quiet, "the summary only");
+  app.add_flag("!--no-rematch", options.rematch,
+               "match then adjust once (without the second registration "
+               "pass of `zebrageo run`)");
   int log_level = -1;
   app.add_option("--log", log_level,
                  "the stages' logs to stderr, with VLOG up to this level "

@@ -106,6 +106,9 @@ struct RematchInput {
   // adjustment.json's record; null: none (the pass is skipped, and
   // nothing else is read).
   const AdjustmentRecord* adjustment = nullptr;
+  // The image evidence (MatchInput::paint_probe); empty: the survey's
+  // images seen with the adjusted trajectory (ImagePaintProbe).
+  decltype(MatchInput::paint_probe) paint_probe;
 };
 // Writes nothing (WriteRematchResults does).
 RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,

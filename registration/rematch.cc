@@ -80,11 +80,14 @@ MatchResult MatchOnAdjustedTrajectory(
   input.index = &index;
   input.rig = &adjusted.rig;
   ImagePaintProbe probe(adjusted);
-  input.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
-                               const BandCornersEnu& band,
-                               const std::vector<BandCornersEnu>& seen) {
-    return probe.Classify(exposure_id, pose, band, seen);
-  };
+  input.paint_probe = first.paint_probe;
+  if (!input.paint_probe) {
+    input.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
+                                 const BandCornersEnu& band,
+                                 const std::vector<BandCornersEnu>& seen) {
+      return probe.Classify(exposure_id, pose, band, seen);
+    };
+  }
   MatchOptions tight = options;
   tight.max_drift_m = rematch.gate_m;
   tight.sd_gate_factor = rematch.sd_gate_factor;

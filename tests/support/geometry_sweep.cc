@@ -258,6 +258,46 @@ std::string GeometryRunResult::Line() const {
   return out.str();
 }
 
+// What `zebrageo run` does after its first adjustment (pipeline.cc): the
+// matches the adjustment rejected removed, the second registration pass on
+// the adjusted trajectory, and the adjustment again when it added matches.
+// Returns the observations it matched; *matches and *adjusted are what the
+// user gets, *rejected the vertex matches the first adjustment rejected.
+int RematchAndAdjust(const Survey& survey,
+                     const SyntheticReconstruction& reconstruction,
+                     const TruthPaintProbe& probe,
+                     const AdjustmentOptions& adjustment,
+                     AdjustmentInput* adjust_input,
+                     std::vector<VertexMatch>* matches,
+                     std::vector<CrossingDecision> decisions,
+                     AdjustmentResult* adjusted, int* rejected) {
+  std::string rejected_crossings;
+  *rejected = RemoveRejectedMatches(*adjusted, matches, &decisions,
+                                    &rejected_crossings);
+  AdjustmentRecord record;
+  record.posterior_sd_computed = adjusted->summary.covariance_computed;
+  record.counts.control_crossings = adjusted->summary.num_control_crossings;
+  record.counts.check_crossings = adjusted->summary.num_check_crossings;
+  RematchInput first;
+  first.vertices = &reconstruction.vertices;
+  first.matches = matches;
+  first.decisions = &decisions;
+  first.adjusted_trajectory = &adjusted->corrected_samples;
+  first.adjustment = &record;
+  first.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
+                               const BandCornersEnu& band,
+                               const std::vector<BandCornersEnu>& seen) {
+    return probe.Classify(exposure_id, pose, band, seen);
+  };
+  RematchSummary rematch = RematchWithAdjustedTrajectory(
+      survey, first, MatchOptions(), RematchOptions());
+  if (rematch.added == 0) return 0;
+  *matches = std::move(rematch.matches);
+  adjust_input->matches = matches;
+  *adjusted = AdjustTrajectory(adjustment, *adjust_input);
+  return rematch.added;
+}
+
 GeometryRunResult RunGeometrySurvey(uint64_t seed,
                                     const GeometrySweepOptions& options,
                                     const std::string& dump_folder) {
@@ -330,14 +370,20 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     adjust_input.roadmarks = &survey.roadmarks;
     adjust_input.vertices = &reconstruction.vertices;
     adjust_input.matches = &match.matches;
-    const AdjustmentResult adjusted =
-        AdjustTrajectory(adjustment, adjust_input);
+    AdjustmentResult adjusted = AdjustTrajectory(adjustment, adjust_input);
+    std::vector<VertexMatch> matches = match.matches;
+    int rejected_first = 0;
+    if (options.rematch && adjusted.summary.IsUsable()) {
+      result.rematched = RematchAndAdjust(
+          survey, reconstruction, probe, adjustment, &adjust_input, &matches,
+          match.decisions, &adjusted, &rejected_first);
+    }
     // Scored as the user gets them: matches.csv keeps only the vertices
     // that became control (RemoveRejectedMatches).
     const std::vector<VertexMatch> kept =
-        MatchesKeptAsControl(match.matches, adjusted);
+        MatchesKeptAsControl(matches, adjusted);
     result.rejected_by_adjustment =
-        static_cast<int>(match.matches.size() - kept.size());
+        rejected_first + static_cast<int>(matches.size() - kept.size());
     ScoreMatches(simulated, reconstruction, TruePoses(simulated), kept,
                  &result);
     result.usable = adjusted.summary.IsUsable();

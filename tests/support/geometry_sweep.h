@@ -48,6 +48,11 @@ struct GeometrySweepOptions {
   // the attitude error by more than worse_attitude_deg.
   double worse_position_m = 0.005;
   double worse_attitude_deg = 0.01;
+  // The sequence of `zebrageo run` (pipeline.cc): after the adjustment, the
+  // matches it rejected removed, the undecided observations matched again
+  // with the adjusted trajectory, and the adjustment again if that added
+  // matches. false: match, then adjust once.
+  bool rematch = true;
 
   std::string Check() const;
 };
@@ -65,6 +70,7 @@ struct GeometryRunResult {
   int wrong = 0;
   int right = 0;
   int rejected_by_adjustment = 0;  // vertex matches
+  int rematched = 0;  // observations the second registration pass matched
   // Wrong matches of vertices of bands the synthesis cut short (one end's
   // vertices 0.25-1 m inside the paint): the band is the right one, its
   // vertices are not where the database's are.
