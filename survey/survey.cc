@@ -141,6 +141,128 @@ RoadmarkDatabase ReadSurveyRoadmarks(
   return ReadRoadmarkLayer(options, manifest.roadmarks);
 }
 
+namespace {
+
+// Poses are interpolated, never extrapolated: an INS drifts fastest
+// exactly where it has no solution.
+void CheckExposuresInsideTrajectory(const Survey& survey) {
+  const SurveyManifest& manifest = survey.manifest;
+  for (const ExposureImage& image : survey.exposures.images) {
+    if (!survey.trajectory.Covers(image.time)) {
+      throw InputError(manifest.exposures, image.line,
+                       "exposure " + std::to_string(image.exposure_id) +
+                           " at time " + FormatDouble(image.time) +
+                           " is outside the trajectory's span [" +
+                           FormatDouble(survey.trajectory.start_time()) + ", " +
+                           FormatDouble(survey.trajectory.end_time()) +
+                           "] of " + manifest.trajectory);
+    }
+  }
+}
+
+// Which images of the exposure table exist, each missing one warned about
+// in *survey. Missing images: a few are warnings (the survey stays usable),
+// many mean a wrong folder or a broken copy. A path out of the folder is
+// refused outright, never read.
+std::vector<bool> ImagesPresent(const std::string& folder,
+                                const SurveyLoadOptions& options,
+                                Survey* survey) {
+  const SurveyManifest& manifest = survey->manifest;
+  const std::vector<ExposureImage>& images = survey->exposures.images;
+  const SurveyPaths paths(folder, options.paths);
+  std::vector<bool> present(images.size(), true);
+  int missing = 0;
+  std::string first_missing;
+  for (size_t i = 0; i < images.size(); ++i) {
+    const ExposureImage& image = images[i];
+    const SurveyFile file = paths.Resolve(image.image);
+    if (file.escapes()) {
+      throw InputError(manifest.exposures, image.line,
+                       "image " + image.image + " " + file.Problem());
+    }
+    if (!file.ok()) {
+      present[i] = false;
+      ++missing;
+      const std::string warning = manifest.exposures + ":" +
+                                  std::to_string(image.line) + ": image " +
+                                  image.image + " " + file.Problem();
+      if (first_missing.empty()) first_missing = warning;
+      LOG(WARNING) << warning;
+      survey->warnings.push_back(warning);
+    }
+  }
+  const int total = static_cast<int>(images.size());
+  if (options.require_images &&
+      missing > options.max_missing_image_fraction * total) {
+    std::ostringstream message;
+    message << missing << " of " << total
+            << " images are missing (more than max_missing_image_fraction = "
+            << options.max_missing_image_fraction
+            << "); first: " << first_missing;
+    throw InputError(manifest.exposures, 0, message.str());
+  }
+  return present;
+}
+
+// Every stereo pair needs one exposure with both its images present.
+void CheckStereoPairsHaveImages(const Survey& survey,
+                                const std::vector<bool>& present) {
+  for (size_t p = 0; p < survey.rig.stereo_pairs.size(); ++p) {
+    const std::array<int, 2>& pair = survey.rig.stereo_pairs[p];
+    bool usable = false;
+    for (const Exposure& exposure : survey.exposures.exposures) {
+      const int left = exposure.image_of_camera[pair[0]];
+      const int right = exposure.image_of_camera[pair[1]];
+      if (left >= 0 && right >= 0 && present[left] && present[right]) {
+        usable = true;
+        break;
+      }
+    }
+    if (!usable) {
+      throw InputError(
+          survey.manifest.exposures, 0,
+          "stereo pair " + std::to_string(p) + " (" +
+              survey.rig.cameras[pair[0]].camera.name() + ", " +
+              survey.rig.cameras[pair[1]].camera.name() +
+              "): no exposure has existing images of both cameras");
+    }
+  }
+}
+
+// "" or the warning for the bands of a 2D layer, whose heights are a guess.
+std::string FlatBandsWarning(const Survey& survey) {
+  const long flat = std::count_if(
+      survey.roadmarks.bands.begin(), survey.roadmarks.bands.end(),
+      [](const RoadmarkBand& band) { return !band.height_known; });
+  if (flat == 0) return "";
+  return survey.manifest.roadmarks + ": " + std::to_string(flat) +
+         " bands without heights (a 2D layer): given the trajectory's "
+         "height less 1.5 m with sigma_z " +
+         FormatDouble(RoadmarkLayerOptions().sigma_z_without_height_m) +
+         " m, so their heights come from the reconstruction and the "
+         "database controls no height";
+}
+
+// What CheckPlausibility finds wrong with the loaded survey.
+std::vector<std::string> PlausibilityWarnings(
+    const Survey& survey, const SurveyLoadOptions& options) {
+  const SurveyManifest& manifest = survey.manifest;
+  PlausibilityInput plausibility;
+  plausibility.trajectory = &survey.trajectory;
+  plausibility.trajectory_file = manifest.trajectory;
+  plausibility.exposures = &survey.exposures;
+  plausibility.exposures_file = manifest.exposures;
+  if (options.load_roadmarks) plausibility.roadmarks = &survey.roadmarks;
+  plausibility.roadmarks_file = manifest.roadmarks;
+  plausibility.origin = manifest.origin;
+  plausibility.origin_line = manifest.origin_line;
+  plausibility.manifest_file = kManifestFile;
+  plausibility.frame = &survey.frame;
+  return CheckPlausibility(plausibility, options.plausibility);
+}
+
+}  // namespace
+
 Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
   const std::string problem = options.Check();
   if (!problem.empty()) {
@@ -173,113 +295,20 @@ Survey LoadSurvey(const std::string& folder, const SurveyLoadOptions& options) {
 
   survey.exposures = ReadExposures(survey.PathOf(manifest.exposures),
                                    manifest.exposures, survey.rig);
-  // Poses are interpolated, never extrapolated: an INS drifts fastest
-  // exactly where it has no solution.
-  for (const ExposureImage& image : survey.exposures.images) {
-    if (!survey.trajectory.Covers(image.time)) {
-      throw InputError(manifest.exposures, image.line,
-                       "exposure " + std::to_string(image.exposure_id) +
-                           " at time " + FormatDouble(image.time) +
-                           " is outside the trajectory's span [" +
-                           FormatDouble(survey.trajectory.start_time()) + ", " +
-                           FormatDouble(survey.trajectory.end_time()) +
-                           "] of " + manifest.trajectory);
-    }
-  }
-
-  // Missing images: a few are warnings (the survey stays usable), many mean
-  // a wrong folder or a broken copy.
-  // A path out of the folder is refused outright, never read.
-  const SurveyPaths paths(folder, options.paths);
-  std::vector<bool> present(survey.exposures.images.size(), true);
-  int missing = 0;
-  std::string first_missing;
-  for (size_t i = 0; i < survey.exposures.images.size(); ++i) {
-    const ExposureImage& image = survey.exposures.images[i];
-    const SurveyFile file = paths.Resolve(image.image);
-    if (file.escapes()) {
-      throw InputError(manifest.exposures, image.line,
-                       "image " + image.image + " " + file.Problem());
-    }
-    if (!file.ok()) {
-      present[i] = false;
-      ++missing;
-      const std::string warning = manifest.exposures + ":" +
-                                  std::to_string(image.line) + ": image " +
-                                  image.image + " " + file.Problem();
-      if (first_missing.empty()) first_missing = warning;
-      LOG(WARNING) << warning;
-      survey.warnings.push_back(warning);
-    }
-  }
-  const int total = static_cast<int>(survey.exposures.images.size());
-  if (options.require_images &&
-      missing > options.max_missing_image_fraction * total) {
-    std::ostringstream message;
-    message << missing << " of " << total
-            << " images are missing (more than max_missing_image_fraction = "
-            << options.max_missing_image_fraction
-            << "); first: " << first_missing;
-    throw InputError(manifest.exposures, 0, message.str());
-  }
-
-  for (size_t p = 0;
-       options.require_images && p < survey.rig.stereo_pairs.size(); ++p) {
-    const std::array<int, 2>& pair = survey.rig.stereo_pairs[p];
-    bool usable = false;
-    for (const Exposure& exposure : survey.exposures.exposures) {
-      const int left = exposure.image_of_camera[pair[0]];
-      const int right = exposure.image_of_camera[pair[1]];
-      if (left >= 0 && right >= 0 && present[left] && present[right]) {
-        usable = true;
-        break;
-      }
-    }
-    if (!usable) {
-      throw InputError(
-          manifest.exposures, 0,
-          "stereo pair " + std::to_string(p) + " (" +
-              survey.rig.cameras[pair[0]].camera.name() + ", " +
-              survey.rig.cameras[pair[1]].camera.name() +
-              "): no exposure has existing images of both cameras");
-    }
-  }
+  CheckExposuresInsideTrajectory(survey);
+  const std::vector<bool> present = ImagesPresent(folder, options, &survey);
+  if (options.require_images) CheckStereoPairsHaveImages(survey, present);
 
   if (options.load_roadmarks) {
     survey.roadmarks =
         ReadSurveyRoadmarks(folder, manifest, survey.trajectory.samples());
-  }
-
-  if (options.load_roadmarks) {
-    const long flat = std::count_if(
-        survey.roadmarks.bands.begin(), survey.roadmarks.bands.end(),
-        [](const RoadmarkBand& band) { return !band.height_known; });
-    if (flat > 0) {
-      const std::string warning =
-          manifest.roadmarks + ": " + std::to_string(flat) +
-          " bands without heights (a 2D layer): given the trajectory's "
-          "height less 1.5 m with sigma_z " +
-          FormatDouble(RoadmarkLayerOptions().sigma_z_without_height_m) +
-          " m, so their heights come from the reconstruction and the "
-          "database controls no height";
+    const std::string warning = FlatBandsWarning(survey);
+    if (!warning.empty()) {
       LOG(WARNING) << warning;
       survey.warnings.push_back(warning);
     }
   }
-
-  PlausibilityInput plausibility;
-  plausibility.trajectory = &survey.trajectory;
-  plausibility.trajectory_file = manifest.trajectory;
-  plausibility.exposures = &survey.exposures;
-  plausibility.exposures_file = manifest.exposures;
-  if (options.load_roadmarks) plausibility.roadmarks = &survey.roadmarks;
-  plausibility.roadmarks_file = manifest.roadmarks;
-  plausibility.origin = manifest.origin;
-  plausibility.origin_line = manifest.origin_line;
-  plausibility.manifest_file = kManifestFile;
-  plausibility.frame = &survey.frame;
-  for (const std::string& warning :
-       CheckPlausibility(plausibility, options.plausibility)) {
+  for (const std::string& warning : PlausibilityWarnings(survey, options)) {
     LOG(WARNING) << warning;
     survey.warnings.push_back(warning);
   }
