@@ -111,12 +111,9 @@ AdjustmentRecord RecordOf(const AdjustmentData& data,
   return r;
 }
 
-void WriteColmapExport(const AdjustmentData& data,
-                       const AdjustmentResult& result,
-                       const std::string& folder) {
-  fs::create_directories(folder);
-  const Rig& rig = data.rig;
-  WriteFileAtomically(folder + "/cameras.txt", [&](std::ostream& out) {
+// cameras.txt of a COLMAP text model: the rig's cameras, FULL_OPENCV.
+void WriteColmapCameras(const Rig& rig, const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
     out << "# Camera list with one line of data per camera:\n"
            "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
            "# zebrageo rig cameras; FULL_OPENCV fx fy cx cy k1 k2 p1 p2 k3 k4 "
@@ -132,60 +129,79 @@ void WriteColmapExport(const AdjustmentData& data,
           << FormatDouble(d[3]) << " " << FormatDouble(d[4]) << " 0 0 0\n";
     }
   });
-  // Points: control vertices (adjusted), then tie points. Observations are
-  // found again per image: control observations are the matched vertices.
-  struct Point {
-    Eigen::Vector3d X;
-    std::vector<std::pair<int, Eigen::Vector2d>> track;  // image, uv
-  };
-  std::vector<Point> points;
-  std::map<std::pair<int64_t, int>, int> image_of;  // (exposure, camera)
-  for (size_t i = 0; i < data.exposures.images.size(); ++i) {
-    image_of[{data.exposures.images[i].exposure_id,
-              data.exposures.images[i].camera}] = static_cast<int>(i);
+}
+
+// A 3D point of the COLMAP export and its observations.
+struct ColmapPoint {
+  Eigen::Vector3d X;
+  std::vector<std::pair<int, Eigen::Vector2d>> track;  // image, uv
+};
+
+// The index of each image of the exposure table by (exposure, camera).
+std::map<std::pair<int64_t, int>, int> ImageIndexOf(
+    const ExposureTable& exposures) {
+  std::map<std::pair<int64_t, int>, int> image_of;
+  for (size_t i = 0; i < exposures.images.size(); ++i) {
+    image_of[{exposures.images[i].exposure_id, exposures.images[i].camera}] =
+        static_cast<int>(i);
   }
-  {
-    std::map<std::tuple<std::string, int, int>, int> index;
-    for (const ControlPointResult& p : result.control_points) {
-      if (p.status != ControlStatus::kControl) continue;
-      index[{p.crossing_id, p.band, p.db_vertex}] =
-          static_cast<int>(points.size());
-      points.push_back({p.adjusted_enu, {}});
+  return image_of;
+}
+
+// The control vertices (adjusted), observed where their matched vertices
+// were seen: in both images of the vertex's stereo pair.
+std::vector<ColmapPoint> ControlPointsForColmap(
+    const AdjustmentData& data, const AdjustmentResult& result) {
+  const Rig& rig = data.rig;
+  const std::map<std::pair<int64_t, int>, int> image_of =
+      ImageIndexOf(data.exposures);
+  std::vector<ColmapPoint> points;
+  std::map<std::tuple<std::string, int, int>, int> index;
+  for (const ControlPointResult& p : result.control_points) {
+    if (p.status != ControlStatus::kControl) continue;
+    index[{p.crossing_id, p.band, p.db_vertex}] =
+        static_cast<int>(points.size());
+    points.push_back({p.adjusted_enu, {}});
+  }
+  std::map<std::tuple<int64_t, int64_t, int>, const ReconstructedVertex*>
+      vertex_of;
+  for (const ReconstructedVertex& v : data.vertices) {
+    vertex_of[{v.exposure_id, v.band_id, v.vertex}] = &v;
+  }
+  for (const VertexMatch& m : data.matches) {
+    const auto p = index.find({m.crossing_id, m.band, m.db_vertex});
+    const auto v = vertex_of.find({m.exposure_id, m.band_id, m.vertex});
+    if (p == index.end() || v == vertex_of.end()) continue;
+    const ReconstructedVertex& vertex = *v->second;
+    if (vertex.pair < 0 ||
+        vertex.pair >= static_cast<int>(rig.stereo_pairs.size())) {
+      continue;
     }
-    std::map<std::tuple<int64_t, int64_t, int>, const ReconstructedVertex*>
-        vertex_of;
-    for (const ReconstructedVertex& v : data.vertices) {
-      vertex_of[{v.exposure_id, v.band_id, v.vertex}] = &v;
-    }
-    for (const VertexMatch& m : data.matches) {
-      const auto p = index.find({m.crossing_id, m.band, m.db_vertex});
-      const auto v = vertex_of.find({m.exposure_id, m.band_id, m.vertex});
-      if (p == index.end() || v == vertex_of.end()) continue;
-      const ReconstructedVertex& vertex = *v->second;
-      if (vertex.pair < 0 ||
-          vertex.pair >= static_cast<int>(rig.stereo_pairs.size())) {
-        continue;
-      }
-      for (int side = 0; side < 2; ++side) {
-        const auto image =
-            image_of.find({m.exposure_id, rig.stereo_pairs[vertex.pair][side]});
-        if (image == image_of.end()) continue;
-        points[p->second].track.emplace_back(
-            image->second, side == 0 ? vertex.uv_left : vertex.uv_right);
-      }
+    for (int side = 0; side < 2; ++side) {
+      const auto image =
+          image_of.find({m.exposure_id, rig.stereo_pairs[vertex.pair][side]});
+      if (image == image_of.end()) continue;
+      points[p->second].track.emplace_back(
+          image->second, side == 0 ? vertex.uv_left : vertex.uv_right);
     }
   }
-  for (const TieTrack& track : result.tie_tracks) {
-    Point point{track.p_enu, {}};
-    for (const TieObservation& o : track.observations) {
-      point.track.emplace_back(o.image, o.uv);
-    }
-    points.push_back(point);
-  }
-  // Per image: its 2D points, and each point's (image, index) track.
-  std::vector<std::vector<std::pair<Eigen::Vector2d, int>>> image_points(
-      data.exposures.images.size());
-  std::vector<std::vector<std::pair<int, int>>> tracks(points.size());
+  return points;
+}
+
+// The observations of a COLMAP model both ways: per image, its 2D points
+// (uv, point); per point, its track (image, index of the 2D point).
+struct ColmapObservations {
+  std::vector<std::vector<std::pair<Eigen::Vector2d, int>>> image_points;
+  std::vector<std::vector<std::pair<int, int>>> tracks;
+};
+
+ColmapObservations ObservationsOf(const std::vector<ColmapPoint>& points,
+                                  size_t num_images) {
+  ColmapObservations observations;
+  auto& image_points = observations.image_points;
+  auto& tracks = observations.tracks;
+  image_points.resize(num_images);
+  tracks.resize(points.size());
   for (size_t p = 0; p < points.size(); ++p) {
     std::map<int, int> seen;  // one observation per image
     for (const auto& [image, uv] : points[p].track) {
@@ -196,11 +212,22 @@ void WriteColmapExport(const AdjustmentData& data,
       image_points[image].emplace_back(uv, static_cast<int>(p));
     }
   }
+  return observations;
+}
+
+// images.txt of a COLMAP text model: the adjusted pose of each image that
+// has one, and its 2D points.
+void WriteColmapImages(
+    const AdjustmentData& data, const AdjustmentResult& result,
+    const std::vector<std::vector<std::pair<Eigen::Vector2d, int>>>&
+        image_points,
+    const std::string& path) {
+  const Rig& rig = data.rig;
   std::map<std::pair<int64_t, std::string>, const CameraPose*> pose_of;
   for (const CameraPose& pose : result.camera_poses) {
     pose_of[{pose.exposure_id, pose.camera}] = &pose;
   }
-  WriteFileAtomically(folder + "/images.txt", [&](std::ostream& out) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
     out << "# Image list with two lines of data per image:\n"
            "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
            "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
@@ -227,7 +254,14 @@ void WriteColmapExport(const AdjustmentData& data,
       out << "\n";
     }
   });
-  WriteFileAtomically(folder + "/points3D.txt", [&](std::ostream& out) {
+}
+
+// points3D.txt of a COLMAP text model: each point and its track.
+void WriteColmapPoints(
+    const std::vector<ColmapPoint>& points,
+    const std::vector<std::vector<std::pair<int, int>>>& tracks,
+    const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
     out << "# 3D point list with one line of data per point:\n"
            "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, "
            "POINT2D_IDX)\n";
@@ -241,6 +275,28 @@ void WriteColmapExport(const AdjustmentData& data,
       out << "\n";
     }
   });
+}
+
+void WriteColmapExport(const AdjustmentData& data,
+                       const AdjustmentResult& result,
+                       const std::string& folder) {
+  fs::create_directories(folder);
+  WriteColmapCameras(data.rig, folder + "/cameras.txt");
+  // Points: control vertices (adjusted), then tie points. Observations are
+  // found again per image: control observations are the matched vertices.
+  std::vector<ColmapPoint> points = ControlPointsForColmap(data, result);
+  for (const TieTrack& track : result.tie_tracks) {
+    ColmapPoint point{track.p_enu, {}};
+    for (const TieObservation& o : track.observations) {
+      point.track.emplace_back(o.image, o.uv);
+    }
+    points.push_back(point);
+  }
+  const ColmapObservations observations =
+      ObservationsOf(points, data.exposures.images.size());
+  WriteColmapImages(data, result, observations.image_points,
+                    folder + "/images.txt");
+  WriteColmapPoints(points, observations.tracks, folder + "/points3D.txt");
 }
 
 }  // namespace

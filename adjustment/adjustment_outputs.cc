@@ -140,6 +140,151 @@ void FillBands(const OutputContext& context, State* state,
   }
 }
 
+// Held-out check points are reported with their residuals from the
+// adjustment that did not see them.
+void MarkHeldOutAsChecks(State* state, AdjustmentSummary* summary) {
+  for (ControlPoint& p : state->points) {
+    if (p.held_out && p.status == ControlStatus::kControl) {
+      p.status = ControlStatus::kCheck;
+      p.normalized_residual = p.held_out_normalized_residual;
+      summary->check_points_in_final = true;
+    }
+  }
+}
+
+// The result of control point p: where its images put it (from the
+// held-out adjustment, or triangulated from its stereo observations), its
+// adjusted position and its reprojection RMS per axis. *triangulated: the
+// images placed it (else image_enu is the database's).
+ControlPointResult ControlPointResultOf(const AdjustmentOptions& options,
+                                        const Rig& rig, const State& state,
+                                        const ControlPoint& p,
+                                        bool* triangulated) {
+  ControlPointResult r;
+  r.crossing_id = p.crossing_id;
+  r.band = p.band;
+  r.db_vertex = p.db_vertex;
+  r.status = p.status;
+  r.database_enu = p.database_enu;
+  r.normalized_residual = p.normalized_residual;
+  r.n_images = static_cast<int>(p.observations.size());
+  Eigen::Matrix3d covariance;
+  double rms_px = 0.0;
+  Eigen::Vector3d X;
+  const bool from_held_out = p.held_out && p.status == ControlStatus::kCheck;
+  if (from_held_out) {
+    X = p.held_out_enu;
+    rms_px = p.held_out_rms_px;
+  }
+  *triangulated =
+      from_held_out ? p.held_out_triangulated
+                    : StereoPosition(options, state, p.stereo, &X, &covariance);
+  if (*triangulated && !from_held_out) {
+    std::vector<double> errors;
+    for (const ImageObservation& o : p.observations) {
+      Eigen::Vector2d e;
+      if (PixelResidual(rig, state, o, X, &e)) errors.push_back(e.norm());
+    }
+    rms_px = Rms(errors);
+  }
+  r.image_enu = *triangulated ? X : p.database_enu;
+  if (p.status == ControlStatus::kControl) {
+    r.adjusted_enu = p.estimate;
+    std::vector<double> errors;
+    for (const ImageObservation& o : p.observations) {
+      Eigen::Vector2d e;
+      if (PixelResidual(rig, state, o, p.estimate, &e)) {
+        errors.push_back(e.norm() / std::sqrt(2.0));
+      }
+    }
+    r.rms_px = Rms(errors);
+  } else {
+    r.adjusted_enu = r.image_enu;
+    r.rms_px = rms_px / std::sqrt(2.0);
+  }
+  return r;
+}
+
+// Adjusted minus database, horizontal and vertical, of the control points
+// and of the check points the images placed; and what the database alone
+// puts into each such check residual.
+struct ControlResiduals {
+  std::vector<double> control_h, control_v, check_h, check_v;
+  std::vector<double> database_h, database_v;
+};
+
+// Adds point p's residuals (result r) and counts it in *summary.
+// offset_variance: of the crossing offset the adjustment models.
+void AddResiduals(const ControlPoint& p, const ControlPointResult& r,
+                  bool triangulated, double offset_variance,
+                  ControlResiduals* residuals, AdjustmentSummary* summary) {
+  const Eigen::Vector3d d = r.adjusted_enu - r.database_enu;
+  if (p.status == ControlStatus::kControl) {
+    ++summary->num_control_points;
+    residuals->control_h.push_back(d.head<2>().norm());
+    residuals->control_v.push_back(d.z());
+  } else if (p.status == ControlStatus::kCheck) {
+    ++summary->num_check_points;
+    if (triangulated) {
+      residuals->check_h.push_back(d.head<2>().norm());
+      residuals->check_v.push_back(d.z());
+      residuals->database_h.push_back(
+          std::sqrt(p.sigma_m.head<2>().squaredNorm() + 2.0 * offset_variance));
+      residuals->database_v.push_back(
+          std::sqrt(p.sigma_m.z() * p.sigma_m.z() + offset_variance));
+    }
+  } else {
+    ++summary->num_rejected_points;
+  }
+}
+
+// The summary's crossing counts and RMS residuals of control and check
+// points, and the trajectory error the check residuals imply.
+void SummariseControlResiduals(const State& state,
+                               const ControlResiduals& residuals,
+                               AdjustmentSummary* summary) {
+  std::set<int> control_crossings, check_crossings;
+  for (const ControlPoint& p : state.points) {
+    if (p.status == ControlStatus::kControl)
+      control_crossings.insert(p.crossing);
+    if (p.status == ControlStatus::kCheck) check_crossings.insert(p.crossing);
+  }
+  summary->num_control_crossings = static_cast<int>(control_crossings.size());
+  summary->num_check_crossings = static_cast<int>(check_crossings.size());
+  summary->control_rmse_horizontal_m = Rms(residuals.control_h);
+  summary->control_rmse_vertical_m = Rms(residuals.control_v);
+  summary->check_rmse_horizontal_m = Rms(residuals.check_h);
+  summary->check_rmse_vertical_m = Rms(residuals.check_v);
+  summary->num_check_points_evaluated =
+      static_cast<int>(residuals.check_h.size());
+  summary->check_database_rms_horizontal_m = Rms(residuals.database_h);
+  summary->check_database_rms_vertical_m = Rms(residuals.database_v);
+  auto implied = [](double rmse, double database) {
+    return std::sqrt(std::max(0.0, rmse * rmse - database * database));
+  };
+  summary->check_implied_trajectory_horizontal_m =
+      implied(summary->check_rmse_horizontal_m,
+              summary->check_database_rms_horizontal_m);
+  summary->check_implied_trajectory_vertical_m = implied(
+      summary->check_rmse_vertical_m, summary->check_database_rms_vertical_m);
+}
+
+// The warning naming the crossings of the rejected control vertices.
+std::string RejectedPointsWarning(const State& state,
+                                  const AdjustmentSummary& summary) {
+  std::set<std::string> names;
+  for (const ControlPoint& p : state.points) {
+    if (p.status == ControlStatus::kRejected) names.insert(p.crossing_id);
+  }
+  std::string list;
+  for (const std::string& name : names)
+    list += (list.empty() ? "" : ", ") + name;
+  return std::to_string(summary.num_rejected_points) +
+         " control vertices rejected (crossings " + list +
+         "): inconsistent with the other crossings, or blunders; not "
+         "used as control, removed from matches.csv";
+}
+
 // Control, check and rejected points with their residuals; the summary's
 // counts and RMSEs.
 void FillControlPoints(const OutputContext& context, State* state,
@@ -147,123 +292,25 @@ void FillControlPoints(const OutputContext& context, State* state,
   const AdjustmentOptions& options = *context.options;
   const Rig& rig = *context.input->rig;
   AdjustmentSummary& summary = result->summary;
-  // Control and check points. Held-out check points are reported with their
-  // residuals from the adjustment that did not see them.
-  for (ControlPoint& p : state->points) {
-    if (p.held_out && p.status == ControlStatus::kControl) {
-      p.status = ControlStatus::kCheck;
-      p.normalized_residual = p.held_out_normalized_residual;
-      summary.check_points_in_final = true;
-    }
-  }
-  std::vector<double> control_h, control_v, check_h, check_v;
+  MarkHeldOutAsChecks(state, &summary);
   // What the database alone puts into a check residual, per the model the
   // adjustment uses for it: the vertex sigma and the crossing offset.
-  std::vector<double> database_h, database_v;
   const double offset_variance =
       options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
-  for (ControlPoint& p : state->points) {
-    ControlPointResult r;
-    r.crossing_id = p.crossing_id;
-    r.band = p.band;
-    r.db_vertex = p.db_vertex;
-    r.status = p.status;
-    r.database_enu = p.database_enu;
-    r.normalized_residual = p.normalized_residual;
-    r.n_images = static_cast<int>(p.observations.size());
-    Eigen::Matrix3d covariance;
-    double rms_px = 0.0;
-    Eigen::Vector3d X;
-    const bool from_held_out = p.held_out && p.status == ControlStatus::kCheck;
-    if (from_held_out) {
-      X = p.held_out_enu;
-      rms_px = p.held_out_rms_px;
-    }
-    const bool triangulated =
-        from_held_out
-            ? p.held_out_triangulated
-            : StereoPosition(options, *state, p.stereo, &X, &covariance);
-    if (triangulated && !from_held_out) {
-      std::vector<double> errors;
-      for (const ImageObservation& o : p.observations) {
-        Eigen::Vector2d e;
-        if (PixelResidual(rig, *state, o, X, &e)) errors.push_back(e.norm());
-      }
-      rms_px = Rms(errors);
-    }
-    r.image_enu = triangulated ? X : p.database_enu;
-    if (p.status == ControlStatus::kControl) {
-      r.adjusted_enu = p.estimate;
-      std::vector<double> errors;
-      for (const ImageObservation& o : p.observations) {
-        Eigen::Vector2d e;
-        if (PixelResidual(rig, *state, o, p.estimate, &e)) {
-          errors.push_back(e.norm() / std::sqrt(2.0));
-        }
-      }
-      r.rms_px = Rms(errors);
-    } else {
-      r.adjusted_enu = r.image_enu;
-      r.rms_px = rms_px / std::sqrt(2.0);
-    }
-    const Eigen::Vector3d d = r.adjusted_enu - r.database_enu;
-    if (p.status == ControlStatus::kControl) {
-      ++summary.num_control_points;
-      control_h.push_back(d.head<2>().norm());
-      control_v.push_back(d.z());
-    } else if (p.status == ControlStatus::kCheck) {
-      ++summary.num_check_points;
-      if (triangulated) {
-        check_h.push_back(d.head<2>().norm());
-        check_v.push_back(d.z());
-        database_h.push_back(std::sqrt(p.sigma_m.head<2>().squaredNorm() +
-                                       2.0 * offset_variance));
-        database_v.push_back(
-            std::sqrt(p.sigma_m.z() * p.sigma_m.z() + offset_variance));
-      }
-    } else {
-      ++summary.num_rejected_points;
-    }
+  ControlResiduals residuals;
+  for (const ControlPoint& p : state->points) {
+    bool triangulated = false;
+    const ControlPointResult r =
+        ControlPointResultOf(options, rig, *state, p, &triangulated);
+    AddResiduals(p, r, triangulated, offset_variance, &residuals, &summary);
     result->control_points.push_back(r);
   }
-  std::set<int> control_crossings, check_crossings;
-  for (const ControlPoint& p : state->points) {
-    if (p.status == ControlStatus::kControl)
-      control_crossings.insert(p.crossing);
-    if (p.status == ControlStatus::kCheck) check_crossings.insert(p.crossing);
-  }
-  summary.num_control_crossings = static_cast<int>(control_crossings.size());
-  summary.num_check_crossings = static_cast<int>(check_crossings.size());
-  summary.control_rmse_horizontal_m = Rms(control_h);
-  summary.control_rmse_vertical_m = Rms(control_v);
-  summary.check_rmse_horizontal_m = Rms(check_h);
-  summary.check_rmse_vertical_m = Rms(check_v);
-  summary.num_check_points_evaluated = static_cast<int>(check_h.size());
-  summary.check_database_rms_horizontal_m = Rms(database_h);
-  summary.check_database_rms_vertical_m = Rms(database_v);
-  auto implied = [](double rmse, double database) {
-    return std::sqrt(std::max(0.0, rmse * rmse - database * database));
-  };
-  summary.check_implied_trajectory_horizontal_m = implied(
-      summary.check_rmse_horizontal_m, summary.check_database_rms_horizontal_m);
-  summary.check_implied_trajectory_vertical_m = implied(
-      summary.check_rmse_vertical_m, summary.check_database_rms_vertical_m);
+  SummariseControlResiduals(*state, residuals, &summary);
   if (summary.num_rejected_points > 0) {
-    std::set<std::string> names;
-    for (const ControlPoint& p : state->points) {
-      if (p.status == ControlStatus::kRejected) names.insert(p.crossing_id);
-    }
-    std::string list;
-    for (const std::string& name : names)
-      list += (list.empty() ? "" : ", ") + name;
-    context.warn(std::to_string(summary.num_rejected_points) +
-                 " control vertices rejected (crossings " + list +
-                 "): inconsistent with the other crossings, or blunders; not "
-                 "used as control, removed from matches.csv");
+    context.warn(RejectedPointsWarning(*state, summary));
   }
 }
 
-// The error model of the final adjustment.
 void SummariseModel(const State& state, AdjustmentSummary* summary) {
   summary->position_sigma_m = state.model.position_sigma_m;
   summary->position_tau_s = state.model.position_tau_s;

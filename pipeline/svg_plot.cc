@@ -148,9 +148,25 @@ int SvgPlot::RightMargin() const {
   return std::max(kMarginRight, static_cast<int>(std::ceil(legend_px)) + 16);
 }
 
-std::string SvgPlot::Render() const {
-  const int margin_right = RightMargin();
+// The plot area in pixels and the data ranges it shows: data (x, y) maps
+// to pixels (X(x), Y(y)), y up.
+struct SvgPlot::Area {
   Range xr, yr;
+  double plot_w = 0.0;
+  double plot_h = 0.0;
+
+  double X(double v) const {
+    return kMarginLeft + (v - xr.min) / (xr.max - xr.min) * plot_w;
+  }
+  double Y(double v) const {
+    return kMarginTop + (yr.max - v) / (yr.max - yr.min) * plot_h;
+  }
+};
+
+SvgPlot::Area SvgPlot::AreaFor(int margin_right) const {
+  Area area;
+  Range& xr = area.xr;
+  Range& yr = area.yr;
   for (const PlotSeries& s : series_) {
     for (double v : s.x) xr.Add(v);
     for (double v : s.y) yr.Add(v);
@@ -163,8 +179,10 @@ std::string SvgPlot::Render() const {
   }
   xr.Pad();
   yr.Pad();
-  const double plot_w = width_px_ - kMarginLeft - margin_right;
-  const double plot_h = height_px_ - kMarginTop - kMarginBottom;
+  area.plot_w = width_px_ - kMarginLeft - margin_right;
+  area.plot_h = height_px_ - kMarginTop - kMarginBottom;
+  const double plot_w = area.plot_w;
+  const double plot_h = area.plot_h;
   if (equal_aspect_) {
     // Grow the smaller span so one metre is as long on both axes.
     const double sx = (xr.max - xr.min) / plot_w;
@@ -176,43 +194,31 @@ std::string SvgPlot::Render() const {
     yr.min = cy - 0.5 * s * plot_h;
     yr.max = cy + 0.5 * s * plot_h;
   }
-  auto X = [&](double v) {
-    return kMarginLeft + (v - xr.min) / (xr.max - xr.min) * plot_w;
-  };
-  auto Y = [&](double v) {
-    return kMarginTop + (yr.max - v) / (yr.max - yr.min) * plot_h;
-  };
+  return area;
+}
 
-  std::ostringstream svg;
-  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << width_px_
-      << "' height='" << height_px_ << "' viewBox='0 0 " << width_px_ << " "
-      << height_px_ << "' font-family='sans-serif' font-size='11'>\n";
-  svg << "<rect width='100%' height='100%' fill='white'/>\n";
-  svg << "<text x='" << width_px_ / 2 << "' y='16' text-anchor='middle' "
-      << "font-size='14' font-weight='bold'>" << EscapeHtml(title_)
-      << "</text>\n";
-  if (!note_.empty()) {
-    svg << "<text x='" << width_px_ / 2 << "' y='32' text-anchor='middle' "
-        << "fill='#555'>" << EscapeHtml(note_) << "</text>\n";
-  }
-  // Axes, grid and ticks.
+void SvgPlot::WriteAxes(const Area& area, std::ostream& svg) const {
+  const Range& xr = area.xr;
+  const Range& yr = area.yr;
+  const double plot_w = area.plot_w;
+  const double plot_h = area.plot_h;
   svg << "<rect x='" << kMarginLeft << "' y='" << kMarginTop << "' width='"
       << plot_w << "' height='" << plot_h << "' fill='none' stroke='#333'/>\n";
   const double x_step = TickStep(xr.max - xr.min, 8);
   for (double v = std::ceil(xr.min / x_step) * x_step; v <= xr.max;
        v += x_step) {
-    svg << "<line x1='" << X(v) << "' y1='" << kMarginTop << "' x2='" << X(v)
-        << "' y2='" << kMarginTop + plot_h << "' stroke='#eee'/>"
-        << "<text x='" << X(v) << "' y='" << kMarginTop + plot_h + 14
+    svg << "<line x1='" << area.X(v) << "' y1='" << kMarginTop << "' x2='"
+        << area.X(v) << "' y2='" << kMarginTop + plot_h << "' stroke='#eee'/>"
+        << "<text x='" << area.X(v) << "' y='" << kMarginTop + plot_h + 14
         << "' text-anchor='middle'>" << Number(v, DecimalsFor(x_step))
         << "</text>\n";
   }
   const double y_step = TickStep(yr.max - yr.min, 6);
   for (double v = std::ceil(yr.min / y_step) * y_step; v <= yr.max;
        v += y_step) {
-    svg << "<line x1='" << kMarginLeft << "' y1='" << Y(v) << "' x2='"
-        << kMarginLeft + plot_w << "' y2='" << Y(v) << "' stroke='#eee'/>"
-        << "<text x='" << kMarginLeft - 4 << "' y='" << Y(v) + 4
+    svg << "<line x1='" << kMarginLeft << "' y1='" << area.Y(v) << "' x2='"
+        << kMarginLeft + plot_w << "' y2='" << area.Y(v) << "' stroke='#eee'/>"
+        << "<text x='" << kMarginLeft - 4 << "' y='" << area.Y(v) + 4
         << "' text-anchor='end'>" << Number(v, DecimalsFor(y_step))
         << "</text>\n";
   }
@@ -221,10 +227,11 @@ std::string SvgPlot::Render() const {
   svg << "<text transform='translate(14," << kMarginTop + plot_h / 2
       << ") rotate(-90)' text-anchor='middle'>" << EscapeHtml(y_label_)
       << "</text>\n";
+}
 
-  // Data, clipped to the plot area.
+void SvgPlot::WriteData(const Area& area, std::ostream& svg) const {
   svg << "<clipPath id='c'><rect x='" << kMarginLeft << "' y='" << kMarginTop
-      << "' width='" << plot_w << "' height='" << plot_h
+      << "' width='" << area.plot_w << "' height='" << area.plot_h
       << "'/></clipPath><g clip-path='url(#c)'>\n";
   for (const PlotSeries& s : series_) {
     const size_t n = std::min(s.x.size(), s.y.size());
@@ -236,8 +243,9 @@ std::string SvgPlot::Render() const {
           colour = ColourScale((s.colour_values[i] - colour_min_) /
                                (colour_max_ - colour_min_));
         }
-        svg << "<circle cx='" << Number(X(s.x[i]), 1) << "' cy='"
-            << Number(Y(s.y[i]), 1) << "' r='2.5' fill='" << colour << "'/>";
+        svg << "<circle cx='" << Number(area.X(s.x[i]), 1) << "' cy='"
+            << Number(area.Y(s.y[i]), 1) << "' r='2.5' fill='" << colour
+            << "'/>";
       }
       svg << "\n";
       continue;
@@ -246,13 +254,14 @@ std::string SvgPlot::Render() const {
         << "' stroke-width='1.5' points='";
     for (size_t i = 0; i < n; ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      svg << Number(X(s.x[i]), 1) << "," << Number(Y(s.y[i]), 1) << " ";
+      svg << Number(area.X(s.x[i]), 1) << "," << Number(area.Y(s.y[i]), 1)
+          << " ";
     }
     svg << "'/>\n";
   }
   for (const PlotArrow& a : arrows_) {
-    const double x0 = X(a.x), y0 = Y(a.y), x1 = X(a.x + a.dx),
-                 y1 = Y(a.y + a.dy);
+    const double x0 = area.X(a.x), y0 = area.Y(a.y), x1 = area.X(a.x + a.dx),
+                 y1 = area.Y(a.y + a.dy);
     const double angle = std::atan2(y1 - y0, x1 - x0);
     svg << "<line x1='" << Number(x0, 1) << "' y1='" << Number(y0, 1)
         << "' x2='" << Number(x1, 1) << "' y2='" << Number(y1, 1)
@@ -266,8 +275,9 @@ std::string SvgPlot::Render() const {
     svg << "\n";
   }
   svg << "</g>\n";
+}
 
-  // Legend of named series.
+void SvgPlot::WriteLegend(int margin_right, std::ostream& svg) const {
   int legend_y = kMarginTop + 6;
   for (const PlotSeries& s : series_) {
     if (s.label.empty()) continue;
@@ -292,6 +302,27 @@ std::string SvgPlot::Render() const {
         << "</text><text x='" << x << "' y='" << top + height + 16 << "'>"
         << EscapeHtml(colour_label_) << "</text>\n";
   }
+}
+
+std::string SvgPlot::Render() const {
+  const int margin_right = RightMargin();
+  const Area area = AreaFor(margin_right);
+  std::ostringstream svg;
+  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << width_px_
+      << "' height='" << height_px_ << "' viewBox='0 0 " << width_px_ << " "
+      << height_px_ << "' font-family='sans-serif' font-size='11'>\n";
+  svg << "<rect width='100%' height='100%' fill='white'/>\n";
+  svg << "<text x='" << width_px_ / 2 << "' y='16' text-anchor='middle' "
+      << "font-size='14' font-weight='bold'>" << EscapeHtml(title_)
+      << "</text>\n";
+  if (!note_.empty()) {
+    svg << "<text x='" << width_px_ / 2 << "' y='32' text-anchor='middle' "
+        << "fill='#555'>" << EscapeHtml(note_) << "</text>\n";
+  }
+  WriteAxes(area, svg);
+  // Data, clipped to the plot area.
+  WriteData(area, svg);
+  WriteLegend(margin_right, svg);
   svg << "</svg>\n";
   return svg.str();
 }

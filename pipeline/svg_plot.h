@@ -4,6 +4,7 @@
 #ifndef ZEBRAGEO_PIPELINE_SVG_PLOT_H_
 #define ZEBRAGEO_PIPELINE_SVG_PLOT_H_
 
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -41,8 +42,19 @@ class SvgPlot {
   std::string Render() const;
 
  private:
+  // The plot area in pixels and the data ranges it shows.
+  struct Area;
   // Right margin wide enough for the legend and the colour scale's label.
   int RightMargin() const;
+  // The ranges of the data (kept to scale when equal_aspect_) in the plot
+  // area left by margin_right.
+  Area AreaFor(int margin_right) const;
+  // The frame, grid lines, ticks and axis labels.
+  void WriteAxes(const Area& area, std::ostream& svg) const;
+  // The series and arrows, clipped to the plot area.
+  void WriteData(const Area& area, std::ostream& svg) const;
+  // The named series and the colour scale, right of the plot area.
+  void WriteLegend(int margin_right, std::ostream& svg) const;
   std::string title_, x_label_, y_label_, note_;
   int width_px_, height_px_;
   std::vector<PlotSeries> series_;

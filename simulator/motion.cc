@@ -128,15 +128,20 @@ Eigen::Matrix3d GeometricRotationEnuBody(double theta, double pitch,
   return RotationEnuFromNed() * RotationNedFromBody(attitude);
 }
 
-}  // namespace
+// The speed profile around vehicle_speed_mps, and the lateral wander in the
+// lane: both drawn from the speed generator, in this order.
+struct SpeedProfile {
+  SmoothSignal speed_wave;
+  SmoothSignal wander;
+  double vehicle_speed_mps;
+  double speed_variation;
 
-VehicleMotion SimulateMotion(const SimulationOptions& options,
-                             const World& world, const LocalFrame& frame) {
-  const Road& road = world.road;
-  const double dt = 1.0 / options.trajectory_rate_hz;
-  VehicleMotion motion;
+  double Speed(double t) const {
+    return vehicle_speed_mps * (1.0 + speed_variation * speed_wave(t));
+  }
+};
 
-  // Speed profile and distance travelled, sample by sample.
+SpeedProfile DrawSpeedProfile(const SimulationOptions& options) {
   std::mt19937_64 speed_rng(SubSeed(options.seed, kSpeedSeed));
   SmoothSignal speed_wave(25.0, &speed_rng);
   SmoothSignal wander(12.0, &speed_rng);
@@ -144,46 +149,79 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
   for (double t = 0.0; t < 4000.0; t += 1.0) probe_times.push_back(t);
   speed_wave.Normalise(probe_times);
   wander.Normalise(probe_times);
-  auto speed = [&](double t) {
-    return options.vehicle_speed_mps *
-           (1.0 + options.speed_variation * speed_wave(t));
-  };
+  return {speed_wave, wander, options.vehicle_speed_mps,
+          options.speed_variation};
+}
+
+// The trajectory's samples: times from the start of the drive, and the road
+// position s of each, the speed integrated sample by sample until
+// s_drive_end.
+struct DriveSamples {
   std::vector<double> times;
   std::vector<double> s_of;
+};
+
+DriveSamples SampleDrive(const World& world, const SpeedProfile& speed,
+                         double dt) {
+  DriveSamples drive;
   double s = world.s_drive_start;
   double t_rel = 0.0;
   for (int k = 0;; ++k) {
     t_rel = k * dt;
-    times.push_back(t_rel);
-    s_of.push_back(s);
+    drive.times.push_back(t_rel);
+    drive.s_of.push_back(s);
     if (s >= world.s_drive_end) break;
-    s += 0.5 * (speed(t_rel) + speed(t_rel + dt)) * dt;
+    s += 0.5 * (speed.Speed(t_rel) + speed.Speed(t_rel + dt)) * dt;
   }
-  const int n = static_cast<int>(times.size());
-  const double duration = times.back();
+  return drive;
+}
 
-  // Suspension: two incommensurate sinusoids per axis, and heave.
-  std::mt19937_64 susp_rng(SubSeed(options.seed, kSuspensionSeed));
-  const double f = options.suspension_frequency_hz;
-  double phase[6];
-  for (double& p : phase) p = Uniform(&susp_rng, 0.0, 2.0 * kPi);
-  auto roll_osc = [&](double t) {
-    return options.suspension_roll_deg * kDegToRad *
-           (std::sin(2 * kPi * f * t + phase[0]) +
-            0.4 * std::sin(2 * kPi * 1.63 * f * t + phase[1])) /
+// Suspension: two incommensurate sinusoids per axis, and heave.
+class Suspension {
+ public:
+  explicit Suspension(const SimulationOptions& options)
+      : roll_deg_(options.suspension_roll_deg),
+        pitch_deg_(options.suspension_pitch_deg),
+        f_(options.suspension_frequency_hz) {
+    std::mt19937_64 susp_rng(SubSeed(options.seed, kSuspensionSeed));
+    for (double& p : phase_) p = Uniform(&susp_rng, 0.0, 2.0 * kPi);
+  }
+  double Roll(double t) const {
+    return roll_deg_ * kDegToRad *
+           (std::sin(2 * kPi * f_ * t + phase_[0]) +
+            0.4 * std::sin(2 * kPi * 1.63 * f_ * t + phase_[1])) /
            1.4;
-  };
-  auto pitch_osc = [&](double t) {
-    return options.suspension_pitch_deg * kDegToRad *
-           (std::sin(2 * kPi * 0.83 * f * t + phase[2]) +
-            0.4 * std::sin(2 * kPi * 1.37 * f * t + phase[3])) /
+  }
+  double Pitch(double t) const {
+    return pitch_deg_ * kDegToRad *
+           (std::sin(2 * kPi * 0.83 * f_ * t + phase_[2]) +
+            0.4 * std::sin(2 * kPi * 1.37 * f_ * t + phase_[3])) /
            1.4;
-  };
-  auto heave = [&](double t) {
-    return 0.008 * std::sin(2 * kPi * 1.1 * f * t + phase[4]);
-  };
+  }
+  double Heave(double t) const {
+    return 0.008 * std::sin(2 * kPi * 1.1 * f_ * t + phase_[4]);
+  }
 
-  // Errors.
+ private:
+  double roll_deg_;
+  double pitch_deg_;
+  double f_;
+  double phase_[6];
+};
+
+// The INS drift: position along and across the road and vertical, then
+// heading, roll and pitch, drawn from the drift generator in this order.
+struct InsDrift {
+  Drift along;
+  Drift across;
+  Drift vertical;
+  Drift heading_error;
+  Drift roll_error;
+  Drift pitch_error;
+};
+
+InsDrift DrawInsDrift(const SimulationOptions& options,
+                      const std::vector<double>& times) {
   std::mt19937_64 drift_rng(SubSeed(options.seed, kDriftSeed));
   const double bias = options.drift_bias_share;
   const double period = options.drift_period_s;
@@ -199,117 +237,169 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
                    &pitch_error}) {
     d->Normalise(times);
   }
+  return {along, across, vertical, heading_error, roll_error, pitch_error};
+}
+
+// The GNSS outage, in seconds from the start of the drive: the direction
+// its error grows in, and that of the jump when GNSS returns.
+struct Outage {
+  bool active = false;
+  double begin = 0.0;
+  double end = 0.0;
+  Eigen::Vector3d direction;
+  Eigen::Vector3d jump_direction;
+};
+
+Outage DrawOutage(const SimulationOptions& options) {
   std::mt19937_64 outage_rng(SubSeed(options.seed, kOutageSeed));
+  Outage outage;
   const double outage_angle = Uniform(&outage_rng, 0.0, 2.0 * kPi);
-  const Eigen::Vector3d outage_direction(
-      std::cos(outage_angle), std::sin(outage_angle),
-      0.3 * (Bernoulli(&outage_rng, 0.5) ? 1.0 : -1.0));
+  outage.direction =
+      Eigen::Vector3d(std::cos(outage_angle), std::sin(outage_angle),
+                      0.3 * (Bernoulli(&outage_rng, 0.5) ? 1.0 : -1.0));
   const double jump_angle = Uniform(&outage_rng, 0.0, 2.0 * kPi);
-  const Eigen::Vector3d jump_direction(std::cos(jump_angle),
-                                       std::sin(jump_angle),
-                                       Uniform(&outage_rng, -0.5, 0.5));
-  const bool has_outage = options.outage_duration_s > 0.0;
-  const double outage_begin = options.outage_start_s;
-  const double outage_end = options.outage_start_s + options.outage_duration_s;
-  const double t0 = options.start_time_s;
-  if (has_outage) {
-    motion.outage_begin_time = t0 + outage_begin;
-    motion.outage_end_time = t0 + outage_end;
+  outage.jump_direction =
+      Eigen::Vector3d(std::cos(jump_angle), std::sin(jump_angle),
+                      Uniform(&outage_rng, -0.5, 0.5));
+  outage.active = options.outage_duration_s > 0.0;
+  outage.begin = options.outage_start_s;
+  outage.end = options.outage_start_s + options.outage_duration_s;
+  return outage;
+}
+
+// Sample-rate jitter: AR(1) per axis, its step sized for the direction of
+// travel (speed * dt per sample) to depart from the heading by
+// jitter_direction_deg RMS.
+class Jitter {
+ public:
+  Jitter(const SimulationOptions& options, double dt)
+      : rng_(SubSeed(options.seed, kJitterSeed)),
+        step_m_(options.vehicle_speed_mps * dt *
+                std::tan(options.jitter_direction_deg * kDegToRad)),
+        decay_(std::exp(-dt / options.jitter_correlation_s)) {}
+  bool active() const { return step_m_ > 0.0; }
+  // The offset of the next sample.
+  const Eigen::Vector3d& Next() {
+    jitter_ = decay_ * jitter_ + Eigen::Vector3d(Gaussian(&rng_, step_m_),
+                                                 Gaussian(&rng_, step_m_),
+                                                 Gaussian(&rng_, step_m_));
+    return jitter_;
   }
 
-  motion.multipath_switches = DrawMultipathSwitches(options, world);
-  // Sample-rate jitter: AR(1) per axis, its step sized for the direction of
-  // travel (speed * dt per sample) to depart from the heading by
-  // jitter_direction_deg RMS.
-  std::mt19937_64 jitter_rng(SubSeed(options.seed, kJitterSeed));
-  const double jitter_step_m =
-      options.vehicle_speed_mps * dt *
-      std::tan(options.jitter_direction_deg * kDegToRad);
-  const double jitter_decay = std::exp(-dt / options.jitter_correlation_s);
-  Eigen::Vector3d jitter = Eigen::Vector3d::Zero();
+ private:
+  std::mt19937_64 rng_;
+  double step_m_;
+  double decay_;
+  Eigen::Vector3d jitter_ = Eigen::Vector3d::Zero();
+};
 
-  motion.truth.reserve(n);
-  motion.measured.reserve(n);
-  for (int k = 0; k < n; ++k) {
-    const double t = times[k];
-    const double sk = s_of[k];
-    // Lateral wander in the lane, and the yaw it implies.
-    const double l = world.lane_offset_m + 0.08 * wander(t);
-    const double dl_dt = 0.08 * (wander(t + 0.01) - wander(t - 0.01)) / 0.02;
-    const double theta = road.Heading(sk) + std::atan2(dl_dt, speed(t));
-    const double pitch = std::atan(road.Grade(sk)) + pitch_osc(t);
-    const double roll = std::atan2(road.Height(sk, l + kHalfTrackM) -
-                                       road.Height(sk, l - kHalfTrackM),
-                                   2.0 * kHalfTrackM) +
-                        roll_osc(t);
-    const Eigen::Matrix3d R_enu_body =
-        GeometricRotationEnuBody(theta, pitch, roll);
-    const Eigen::Vector3d p_enu =
-        road.SurfacePoint(sk, l) +
-        R_enu_body * Eigen::Vector3d(0.0, 0.0, -options.imu_height_m) +
-        Eigen::Vector3d(0.0, 0.0, heave(t));
+// The vehicle's true pose at time t from the start of the drive, at road
+// position s: lateral wander in the lane and the yaw it implies, pitch from
+// the grade, roll from the camber, plus the suspension.
+struct TruePose {
+  Eigen::Matrix3d R_enu_body;
+  Eigen::Vector3d p_enu;
+};
 
-    TrajectorySample truth;
-    truth.time = t0 + t;
-    truth.position = frame.GeodeticFromEnu(p_enu);
-    truth.attitude =
-        frame.AttitudeFromRotationEnuBody(truth.position, R_enu_body);
-    motion.truth.push_back(truth);
-    motion.s_m.push_back(sk);
+TruePose TruePoseAt(const SimulationOptions& options, const World& world,
+                    const SpeedProfile& speed, const Suspension& suspension,
+                    double t, double sk) {
+  const Road& road = world.road;
+  const double l = world.lane_offset_m + 0.08 * speed.wander(t);
+  const double dl_dt =
+      0.08 * (speed.wander(t + 0.01) - speed.wander(t - 0.01)) / 0.02;
+  const double theta = road.Heading(sk) + std::atan2(dl_dt, speed.Speed(t));
+  const double pitch = std::atan(road.Grade(sk)) + suspension.Pitch(t);
+  const double roll = std::atan2(road.Height(sk, l + kHalfTrackM) -
+                                     road.Height(sk, l - kHalfTrackM),
+                                 2.0 * kHalfTrackM) +
+                      suspension.Roll(t);
+  TruePose pose;
+  pose.R_enu_body = GeometricRotationEnuBody(theta, pitch, roll);
+  pose.p_enu =
+      road.SurfacePoint(sk, l) +
+      pose.R_enu_body * Eigen::Vector3d(0.0, 0.0, -options.imu_height_m) +
+      Eigen::Vector3d(0.0, 0.0, suspension.Heave(t));
+  return pose;
+}
 
-    // Position error: drift in the road frame at the vehicle, outage growth,
-    // jump at GNSS return.
-    const Eigen::Vector2d tangent = road.Tangent(sk);
-    const Eigen::Vector2d normal = road.LeftNormal(sk);
-    const Eigen::Vector2d horizontal = along(t) * tangent + across(t) * normal;
-    Eigen::Vector3d error(horizontal.x(), horizontal.y(), vertical(t));
-    if (!motion.multipath_switches.empty()) {
-      error.head<2>() += MultipathError(motion.multipath_switches, sk) * normal;
-    }
-    if (jitter_step_m > 0.0) {
-      jitter = jitter_decay * jitter +
-               Eigen::Vector3d(Gaussian(&jitter_rng, jitter_step_m),
-                               Gaussian(&jitter_rng, jitter_step_m),
-                               Gaussian(&jitter_rng, jitter_step_m));
-      error += jitter;
-    }
-    double outage_fraction = 0.0;
-    double extra_heading = 0.0;
-    if (has_outage && t >= outage_begin && t < outage_end) {
-      outage_fraction = (t - outage_begin) / options.outage_duration_s;
-      error += options.outage_drift_m * outage_fraction * outage_fraction *
-               outage_direction;
-      extra_heading = options.heading_drift_deg * kDegToRad * outage_fraction;
-    }
-    if (has_outage && t >= outage_end) {
-      error += options.gnss_return_jump_m * std::exp(-(t - outage_end) / 20.0) *
-               jump_direction;
-    }
-    const Eigen::Vector3d attitude_error(roll_error(t), pitch_error(t),
-                                         heading_error(t) + extra_heading);
-    TrajectorySample measured;
-    measured.time = truth.time;
-    measured.position = frame.GeodeticFromEnu(p_enu + error);
-    measured.attitude.roll = truth.attitude.roll + attitude_error.x();
-    measured.attitude.pitch = truth.attitude.pitch + attitude_error.y();
-    measured.attitude.heading = truth.attitude.heading + attitude_error.z();
-    const double grow = 0.2 * outage_fraction;
-    measured.sd_enu_m = Eigen::Vector3d(options.reported_sd_horizontal_m + grow,
-                                        options.reported_sd_horizontal_m + grow,
-                                        options.reported_sd_vertical_m + grow);
-    measured.sd_attitude_rad =
-        Eigen::Vector3d(options.reported_sd_tilt_deg,
-                        options.reported_sd_tilt_deg,
-                        options.reported_sd_heading_deg) *
-        kDegToRad;
-    motion.measured.push_back(measured);
-    motion.position_error_enu.push_back(error);
-    motion.attitude_error_rad.push_back(attitude_error);
+// The position error of a sample, and how far into the outage it is with
+// the heading error the outage adds.
+struct SampleError {
+  Eigen::Vector3d position;
+  double outage_fraction = 0.0;
+  double extra_heading = 0.0;
+};
+
+// Drift in the road frame at the vehicle, multipath, jitter, outage growth,
+// jump at GNSS return.
+SampleError SampleErrorAt(const SimulationOptions& options, const Road& road,
+                          const InsDrift& drift,
+                          const std::vector<MultipathSwitch>& switches,
+                          const Outage& outage, Jitter* jitter, double t,
+                          double sk) {
+  const Eigen::Vector2d tangent = road.Tangent(sk);
+  const Eigen::Vector2d normal = road.LeftNormal(sk);
+  const Eigen::Vector2d horizontal =
+      drift.along(t) * tangent + drift.across(t) * normal;
+  SampleError sample;
+  Eigen::Vector3d& error = sample.position;
+  error = Eigen::Vector3d(horizontal.x(), horizontal.y(), drift.vertical(t));
+  if (!switches.empty()) {
+    error.head<2>() += MultipathError(switches, sk) * normal;
   }
+  if (jitter->active()) error += jitter->Next();
+  if (outage.active && t >= outage.begin && t < outage.end) {
+    sample.outage_fraction = (t - outage.begin) / options.outage_duration_s;
+    error += options.outage_drift_m * sample.outage_fraction *
+             sample.outage_fraction * outage.direction;
+    sample.extra_heading =
+        options.heading_drift_deg * kDegToRad * sample.outage_fraction;
+  }
+  if (outage.active && t >= outage.end) {
+    error += options.gnss_return_jump_m * std::exp(-(t - outage.end) / 20.0) *
+             outage.jump_direction;
+  }
+  return sample;
+}
 
-  // Exposures: every exposure_spacing_m +- jitter of road, times rounded to
-  // 0.1 ms; ids start at 1000 with occasional gaps.
+// The measured sample: the true one moved by the errors, with the
+// standard deviations the INS reports (growing through the outage).
+TrajectorySample MeasuredSampleOf(const SimulationOptions& options,
+                                  const LocalFrame& frame,
+                                  const TrajectorySample& truth,
+                                  const Eigen::Vector3d& p_enu,
+                                  const SampleError& error,
+                                  const Eigen::Vector3d& attitude_error) {
+  TrajectorySample measured;
+  measured.time = truth.time;
+  measured.position = frame.GeodeticFromEnu(p_enu + error.position);
+  measured.attitude.roll = truth.attitude.roll + attitude_error.x();
+  measured.attitude.pitch = truth.attitude.pitch + attitude_error.y();
+  measured.attitude.heading = truth.attitude.heading + attitude_error.z();
+  const double grow = 0.2 * error.outage_fraction;
+  measured.sd_enu_m = Eigen::Vector3d(options.reported_sd_horizontal_m + grow,
+                                      options.reported_sd_horizontal_m + grow,
+                                      options.reported_sd_vertical_m + grow);
+  measured.sd_attitude_rad = Eigen::Vector3d(options.reported_sd_tilt_deg,
+                                             options.reported_sd_tilt_deg,
+                                             options.reported_sd_heading_deg) *
+                             kDegToRad;
+  return measured;
+}
+
+// Exposures: every exposure_spacing_m +- jitter of road, times rounded to
+// 0.1 ms; ids start at 1000 with occasional gaps.
+std::vector<ExposureEvent> DrawExposures(const SimulationOptions& options,
+                                         const World& world,
+                                         const DriveSamples& drive, double dt,
+                                         double t0) {
+  const std::vector<double>& times = drive.times;
+  const std::vector<double>& s_of = drive.s_of;
+  const int n = static_cast<int>(times.size());
+  const double duration = times.back();
   std::mt19937_64 exposure_rng(SubSeed(options.seed, kExposureSeed));
+  std::vector<ExposureEvent> exposures;
   int64_t id = 1000;
   double next = world.s_drive_start + 1.0;
   int k = 0;
@@ -319,12 +409,61 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
     const double u = (next - s_of[k]) / (s_of[k + 1] - s_of[k]);
     double t = std::round((times[k] + u * dt) * 1e4) / 1e4;
     t = std::clamp(t, times.front() + 1e-4, duration - 1e-4);
-    motion.exposures.push_back({id, t0 + t, next});
+    exposures.push_back({id, t0 + t, next});
     id += Bernoulli(&exposure_rng, 0.05) ? UniformInt(&exposure_rng, 2, 6) : 1;
     next += options.exposure_spacing_m +
             Uniform(&exposure_rng, -options.exposure_spacing_jitter_m,
                     options.exposure_spacing_jitter_m);
   }
+  return exposures;
+}
+
+}  // namespace
+
+VehicleMotion SimulateMotion(const SimulationOptions& options,
+                             const World& world, const LocalFrame& frame) {
+  const double dt = 1.0 / options.trajectory_rate_hz;
+  const SpeedProfile speed = DrawSpeedProfile(options);
+  const DriveSamples drive = SampleDrive(world, speed, dt);
+  const int n = static_cast<int>(drive.times.size());
+  const Suspension suspension(options);
+  const InsDrift drift = DrawInsDrift(options, drive.times);
+  const Outage outage = DrawOutage(options);
+  const double t0 = options.start_time_s;
+  VehicleMotion motion;
+  if (outage.active) {
+    motion.outage_begin_time = t0 + outage.begin;
+    motion.outage_end_time = t0 + outage.end;
+  }
+  motion.multipath_switches = DrawMultipathSwitches(options, world);
+  Jitter jitter(options, dt);
+
+  motion.truth.reserve(n);
+  motion.measured.reserve(n);
+  for (int k = 0; k < n; ++k) {
+    const double t = drive.times[k];
+    const double sk = drive.s_of[k];
+    const TruePose pose = TruePoseAt(options, world, speed, suspension, t, sk);
+    TrajectorySample truth;
+    truth.time = t0 + t;
+    truth.position = frame.GeodeticFromEnu(pose.p_enu);
+    truth.attitude =
+        frame.AttitudeFromRotationEnuBody(truth.position, pose.R_enu_body);
+    motion.truth.push_back(truth);
+    motion.s_m.push_back(sk);
+
+    const SampleError error =
+        SampleErrorAt(options, world.road, drift, motion.multipath_switches,
+                      outage, &jitter, t, sk);
+    const Eigen::Vector3d attitude_error(
+        drift.roll_error(t), drift.pitch_error(t),
+        drift.heading_error(t) + error.extra_heading);
+    motion.measured.push_back(MeasuredSampleOf(
+        options, frame, truth, pose.p_enu, error, attitude_error));
+    motion.position_error_enu.push_back(error.position);
+    motion.attitude_error_rad.push_back(attitude_error);
+  }
+  motion.exposures = DrawExposures(options, world, drive, dt, t0);
   return motion;
 }
 

@@ -42,6 +42,130 @@ float PaintTone(double x, double y, double footprint_m, uint64_t salt) {
   }
   return kPaintTone * grain;
 }
+
+// A shop window of the ground floor at `along` the front face (of
+// `face_length`), height h over the pavement; leaves *value, *key as they
+// are elsewhere.
+void ShadeShopWindow(const Building& b, double along, double face_length,
+                     double h, uint64_t id, float* value, uint32_t* key) {
+  const double period = 2.0 * b.window_period_m;
+  const double col = std::floor((along - 0.5) / period);
+  const double x = along - 0.5 - col * period;
+  if (col >= 0 && along < face_length - 0.5 && x < 0.75 * period && h > 0.4 &&
+      h < b.ground_floor_height_m - 0.6) {
+    *value = static_cast<float>(
+        b.window_tone *
+        (0.8 +
+         0.5 * HashToUnit(HashLattice(static_cast<int64_t>(col), -1, b.salt))));
+    *key = Key(kWindow, id * 64 + static_cast<uint64_t>(col) % 64);
+  }
+}
+
+// A window of an upper storey (frame or glass) at `along` the front face
+// (of `face_length`), height h over the pavement; leaves *value, *key as
+// they are between windows.
+void ShadeStoreyWindow(const Building& b, double along, double face_length,
+                       double h, uint64_t id, float* value, uint32_t* key) {
+  const double storey =
+      std::floor((h - b.ground_floor_height_m) / b.floor_height_m);
+  const double hv = h - b.ground_floor_height_m - storey * b.floor_height_m;
+  const double col =
+      std::floor((along - b.window_offset_m) / b.window_period_m);
+  const double x = along - b.window_offset_m - col * b.window_period_m;
+  if (col >= 0 && along < face_length - 0.3 && x < b.window_width_m &&
+      hv > b.sill_height_m && hv < b.sill_height_m + b.window_height_m) {
+    const double frame = 0.07;
+    const bool is_frame = x < frame || x > b.window_width_m - frame ||
+                          hv < b.sill_height_m + frame ||
+                          hv > b.sill_height_m + b.window_height_m - frame;
+    const uint64_t window =
+        (static_cast<uint64_t>(storey) * 97 + static_cast<uint64_t>(col)) * 2 +
+        (is_frame ? 1 : 0);
+    if (is_frame) {
+      *value = 205.0f;
+    } else {
+      // Dark glass with a sky reflection rising with height, and
+      // curtains varying per window.
+      const float shade =
+          0.75f + 0.6f * HashToUnit(HashLattice(static_cast<int64_t>(col),
+                                                static_cast<int64_t>(storey),
+                                                b.salt + 2));
+      *value = static_cast<float>(
+          b.window_tone * shade *
+          (1.0 + 0.3 * (hv - b.sill_height_m) / b.window_height_m));
+    }
+    *key = Key(kWindow, id * 4096 + window);
+  }
+}
+
+// A building's wall at p (u along the box's axis_u): noisy plaster, and on
+// its front face a cornice, shop windows and storeys of windows.
+void ShadeBuilding(const Building& b, const VerticalBox& box,
+                   const Eigen::Vector3d& p, double u, int face,
+                   double footprint, uint64_t id, float* value, uint32_t* key) {
+  const bool front = face == (b.front_side > 0 ? 3 : 2);
+  const double h = p.z() - (box.z0 + 0.5);
+  const double wall_noise =
+      0.93 + 0.14 * ValueNoise(u / 0.7, p.z() / 0.7, b.salt) +
+      (footprint < 0.02
+           ? 0.04 * (ValueNoise(u / 0.05, p.z() / 0.05, b.salt + 1) - 0.5)
+           : 0.0);
+  *value = static_cast<float>(b.wall_tone * wall_noise);
+  *key = Key(kWall, id);
+  if (!front || face >= 4) return;
+  // Face coordinate from the face's start.
+  const double along = u + box.half_u;
+  const double face_length = 2.0 * box.half_u;
+  if (h > box.z1 - box.z0 - 1.0) {
+    *value *= 0.8f;  // cornice
+    *key = Key(kWall, id + 4);
+  } else if (h < b.ground_floor_height_m) {
+    if (b.shop_front) {
+      ShadeShopWindow(b, along, face_length, h, id, value, key);
+    }
+  } else {
+    ShadeStoreyWindow(b, along, face_length, h, id, value, key);
+  }
+}
+
+// A parked vehicle's body at p (u, v along the box's axes): roof, tyres
+// and wheels, windows, head and tail lights.
+void ShadeVehicle(const ParkedVehicle& car, const VerticalBox& box,
+                  const Eigen::Vector3d& p, double u, double v, int face,
+                  uint64_t id, float* value, uint32_t* key) {
+  const double height = box.z1 - box.z0;
+  const double h = p.z() - box.z0;
+  *value = car.body_tone;
+  *key = Key(kVehicle, id * 8);
+  if (face == 4) {
+    *value *= 1.05f;
+    return;
+  }
+  if (h < 0.25) {
+    *value = 22.0f;
+    *key = Key(kVehicle, id * 8 + 1);
+    return;
+  }
+  const bool side = face >= 2;
+  const double across = side ? u : v;
+  const double half = side ? box.half_u : box.half_v;
+  const double wheel_x = std::abs(std::abs(across) - (half - 0.8));
+  const double wheel_r = std::hypot(wheel_x, h - 0.33);
+  if (side && wheel_r < 0.33) {
+    *value = wheel_r < 0.18 ? 95.0f : 25.0f;
+    *key = Key(kVehicle, id * 8 + (wheel_r < 0.18 ? 2 : 3));
+  } else if (h > 0.6 * height && h < 0.92 * height &&
+             std::abs(across) < half - (side ? 0.5 : 0.15)) {
+    *value = 38.0f +
+             25.0f * static_cast<float>((h - 0.6 * height) / (0.32 * height));
+    *key = Key(kVehicle, id * 8 + 4);
+  } else if (!side && h > 0.55 * height - 0.2 && h < 0.55 * height &&
+             std::abs(std::abs(across) - (half - 0.25)) < 0.15) {
+    *value = face == 1 ? 220.0f : 90.0f;  // headlights, tail lights
+    *key = Key(kVehicle, id * 8 + 5);
+  }
+}
+
 }  // namespace
 
 // The paint of the bands of crossing `index` near the ground point *p: the
@@ -222,104 +346,11 @@ Sample ImageScene::ShadeBox(const Eigen::Vector3d& d, const BoxHit& hit) const {
   float value;
   uint32_t key;
   if (!ref.is_vehicle) {
-    const Building& b = world_.buildings[ref.index];
-    const bool front = hit.face == (b.front_side > 0 ? 3 : 2);
-    const double h = p.z() - (box.z0 + 0.5);
-    const double wall_noise =
-        0.93 + 0.14 * ValueNoise(u / 0.7, p.z() / 0.7, b.salt) +
-        (footprint < 0.02
-             ? 0.04 * (ValueNoise(u / 0.05, p.z() / 0.05, b.salt + 1) - 0.5)
-             : 0.0);
-    value = static_cast<float>(b.wall_tone * wall_noise);
-    key = Key(kWall, id);
-    if (front && hit.face < 4) {
-      // Face coordinate from the face's start.
-      const double along = u + box.half_u;
-      const double face_length = 2.0 * box.half_u;
-      if (h > box.z1 - box.z0 - 1.0) {
-        value *= 0.8f;  // cornice
-        key = Key(kWall, id + 4);
-      } else if (h < b.ground_floor_height_m) {
-        if (b.shop_front) {
-          const double period = 2.0 * b.window_period_m;
-          const double col = std::floor((along - 0.5) / period);
-          const double x = along - 0.5 - col * period;
-          if (col >= 0 && along < face_length - 0.5 && x < 0.75 * period &&
-              h > 0.4 && h < b.ground_floor_height_m - 0.6) {
-            value = static_cast<float>(
-                b.window_tone *
-                (0.8 + 0.5 * HashToUnit(HashLattice(static_cast<int64_t>(col),
-                                                    -1, b.salt))));
-            key = Key(kWindow, id * 64 + static_cast<uint64_t>(col) % 64);
-          }
-        }
-      } else {
-        const double storey =
-            std::floor((h - b.ground_floor_height_m) / b.floor_height_m);
-        const double hv =
-            h - b.ground_floor_height_m - storey * b.floor_height_m;
-        const double col =
-            std::floor((along - b.window_offset_m) / b.window_period_m);
-        const double x = along - b.window_offset_m - col * b.window_period_m;
-        if (col >= 0 && along < face_length - 0.3 && x < b.window_width_m &&
-            hv > b.sill_height_m && hv < b.sill_height_m + b.window_height_m) {
-          const double frame = 0.07;
-          const bool is_frame =
-              x < frame || x > b.window_width_m - frame ||
-              hv < b.sill_height_m + frame ||
-              hv > b.sill_height_m + b.window_height_m - frame;
-          const uint64_t window = (static_cast<uint64_t>(storey) * 97 +
-                                   static_cast<uint64_t>(col)) *
-                                      2 +
-                                  (is_frame ? 1 : 0);
-          if (is_frame) {
-            value = 205.0f;
-          } else {
-            // Dark glass with a sky reflection rising with height, and
-            // curtains varying per window.
-            const float shade =
-                0.75f + 0.6f * HashToUnit(HashLattice(
-                                   static_cast<int64_t>(col),
-                                   static_cast<int64_t>(storey), b.salt + 2));
-            value = static_cast<float>(
-                b.window_tone * shade *
-                (1.0 + 0.3 * (hv - b.sill_height_m) / b.window_height_m));
-          }
-          key = Key(kWindow, id * 4096 + window);
-        }
-      }
-    }
+    ShadeBuilding(world_.buildings[ref.index], box, p, u, hit.face, footprint,
+                  id, &value, &key);
   } else {
-    const ParkedVehicle& car = world_.vehicles[ref.index];
-    const double height = box.z1 - box.z0;
-    const double h = p.z() - box.z0;
-    value = car.body_tone;
-    key = Key(kVehicle, id * 8);
-    if (hit.face == 4) {
-      value *= 1.05f;
-    } else if (h < 0.25) {
-      value = 22.0f;
-      key = Key(kVehicle, id * 8 + 1);
-    } else {
-      const bool side = hit.face >= 2;
-      const double across = side ? u : v;
-      const double half = side ? box.half_u : box.half_v;
-      const double wheel_x = std::abs(std::abs(across) - (half - 0.8));
-      const double wheel_r = std::hypot(wheel_x, h - 0.33);
-      if (side && wheel_r < 0.33) {
-        value = wheel_r < 0.18 ? 95.0f : 25.0f;
-        key = Key(kVehicle, id * 8 + (wheel_r < 0.18 ? 2 : 3));
-      } else if (h > 0.6 * height && h < 0.92 * height &&
-                 std::abs(across) < half - (side ? 0.5 : 0.15)) {
-        value = 38.0f + 25.0f * static_cast<float>((h - 0.6 * height) /
-                                                   (0.32 * height));
-        key = Key(kVehicle, id * 8 + 4);
-      } else if (!side && h > 0.55 * height - 0.2 && h < 0.55 * height &&
-                 std::abs(std::abs(across) - (half - 0.25)) < 0.15) {
-        value = hit.face == 1 ? 220.0f : 90.0f;  // headlights, tail lights
-        key = Key(kVehicle, id * 8 + 5);
-      }
-    }
+    ShadeVehicle(world_.vehicles[ref.index], box, p, u, v, hit.face, id, &value,
+                 &key);
   }
   return {Fog(value * light, distance), key};
 }

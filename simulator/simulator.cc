@@ -66,18 +66,8 @@ namespace {
 namespace fs = std::filesystem;
 using sim::World;
 
-nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
-                        const sim::VehicleMotion& motion,
-                        const SimulationSummary& summary) {
-  nlohmann::json meta;
-  meta["generator"] = "zebrageo simulate";
-  meta["preset"] = options.preset;
-  meta["seed"] = options.seed;
-  meta["expect"] = "ok";
-  meta["render_images"] = options.render_images;
-  meta["options"] = OptionsToJson(options);
-  meta["origin"] = {options.origin_lat_deg, options.origin_lon_deg,
-                    options.origin_h_m};
+// The road of meta.json: its length, width, driven part and segments.
+nlohmann::json RoadJson(const World& world) {
   nlohmann::json road;
   road["centreline_length_m"] = world.road.length_m();
   road["width_m"] = world.road.width_m();
@@ -94,43 +84,50 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
   road["note"] =
       "radius 0 = straight; signed radius > 0 turns left; a segment whose "
       "two radii differ is a clothoid";
-  meta["road"] = road;
+  return road;
+}
 
-  nlohmann::json crossings = nlohmann::json::array();
+// One crossing of meta.json: its design, where it is, and its faults.
+nlohmann::json CrossingJson(const World& world, const sim::Crossing& c) {
+  nlohmann::json j;
+  j["crossing_id"] = c.id;
+  j["in_db"] = c.in_db;
+  j["in_street"] = c.in_street;
+  j["num_bands"] = c.in_street ? c.num_street_bands : 0;
+  j["num_bands_db"] =
+      c.in_db ? c.num_db_bands - static_cast<int>(c.db_missing_bands.size())
+              : 0;
+  j["skew_deg"] = c.skew_deg;
+  j["band_length_m"] = c.band_length_m;
+  j["band_width_m"] = c.band_width_m;
+  j["band_period_m"] = c.band_period_m;
+  j["s_m"] = c.s_m;
+  const Eigen::Vector3d centre = world.road.SurfacePoint(c.s_m, 0.0);
+  j["origin_enu"] = {c.origin_xy.x(), c.origin_xy.y(), centre.z()};
+  j["db_offset_m"] = {c.db_offset_enu.x(), c.db_offset_enu.y(),
+                      c.db_offset_enu.z()};
+  j["repainted"] = c.repainted;
+  j["repaint_shift_m"] = {c.repaint_shift_xy.x(), c.repaint_shift_xy.y(), 0.0};
+  j["missing_band"] = c.missing_band_kind.empty()
+                          ? nlohmann::json(nullptr)
+                          : nlohmann::json(c.missing_band_kind);
+  j["stop_line"] = c.stop_line;
+  j["occluded_by_vehicle"] = c.occluded_by_vehicle;
+  if (!c.db_missing_bands.empty()) j["db_missing_bands"] = c.db_missing_bands;
+  if (!c.end_band_vehicle.empty()) j["end_band_vehicle"] = c.end_band_vehicle;
+  return j;
+}
+
+// The faults of meta.json: crossings missing, stale or repainted, bands
+// missing from the street or the database, and the database's road lines
+// that differ from the street.
+nlohmann::json FaultsJson(const World& world) {
   nlohmann::json faults;
   faults["missing_crossings"] = nlohmann::json::array();
   faults["stale_crossings"] = nlohmann::json::array();
   faults["repainted_crossings"] = nlohmann::json::array();
   faults["missing_bands"] = nlohmann::json::array();
   for (const sim::Crossing& c : world.crossings) {
-    nlohmann::json j;
-    j["crossing_id"] = c.id;
-    j["in_db"] = c.in_db;
-    j["in_street"] = c.in_street;
-    j["num_bands"] = c.in_street ? c.num_street_bands : 0;
-    j["num_bands_db"] =
-        c.in_db ? c.num_db_bands - static_cast<int>(c.db_missing_bands.size())
-                : 0;
-    j["skew_deg"] = c.skew_deg;
-    j["band_length_m"] = c.band_length_m;
-    j["band_width_m"] = c.band_width_m;
-    j["band_period_m"] = c.band_period_m;
-    j["s_m"] = c.s_m;
-    const Eigen::Vector3d centre = world.road.SurfacePoint(c.s_m, 0.0);
-    j["origin_enu"] = {c.origin_xy.x(), c.origin_xy.y(), centre.z()};
-    j["db_offset_m"] = {c.db_offset_enu.x(), c.db_offset_enu.y(),
-                        c.db_offset_enu.z()};
-    j["repainted"] = c.repainted;
-    j["repaint_shift_m"] = {c.repaint_shift_xy.x(), c.repaint_shift_xy.y(),
-                            0.0};
-    j["missing_band"] = c.missing_band_kind.empty()
-                            ? nlohmann::json(nullptr)
-                            : nlohmann::json(c.missing_band_kind);
-    j["stop_line"] = c.stop_line;
-    j["occluded_by_vehicle"] = c.occluded_by_vehicle;
-    if (!c.db_missing_bands.empty()) j["db_missing_bands"] = c.db_missing_bands;
-    if (!c.end_band_vehicle.empty()) j["end_band_vehicle"] = c.end_band_vehicle;
-    crossings.push_back(j);
     if (!c.in_db) faults["missing_crossings"].push_back(c.id);
     if (!c.in_street) faults["stale_crossings"].push_back(c.id);
     if (c.repainted) faults["repainted_crossings"].push_back(c.id);
@@ -165,9 +162,13 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
     if (f.crossing >= 0) j["crossing_id"] = world.crossings[f.crossing].id;
     faults["database_lines"].push_back(j);
   }
-  meta["crossings"] = crossings;
-  meta["faults"] = faults;
+  return faults;
+}
 
+// The trajectory error of meta.json: its extremes, the outage and the
+// multipath switches.
+nlohmann::json TrajectoryErrorJson(const SimulationOptions& options,
+                                   const sim::VehicleMotion& motion) {
   double max_h = 0.0, max_v = 0.0, sum_h2 = 0.0, max_heading = 0.0;
   for (size_t k = 0; k < motion.position_error_enu.size(); ++k) {
     const Eigen::Vector3d& e = motion.position_error_enu[k];
@@ -197,8 +198,11 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
                                            {"length_m", m.length_m},
                                            {"cross_track_m", m.cross_track_m}});
   }
-  meta["trajectory_error"] = error;
+  return error;
+}
 
+nlohmann::json CountsJson(const World& world,
+                          const SimulationSummary& summary) {
   nlohmann::json counts;
   counts["crossings_in_street"] = summary.num_crossings_in_street;
   counts["crossings_in_db"] = summary.num_crossings_in_database;
@@ -213,33 +217,43 @@ nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
   counts["parked_vehicles"] = static_cast<int>(world.vehicles.size());
   counts["manholes"] = static_cast<int>(world.manholes.size());
   counts["stains"] = static_cast<int>(world.stains.size());
-  meta["counts"] = counts;
+  return counts;
+}
+
+// truth/meta.json: what was simulated, for scoring and for people.
+nlohmann::json MetaJson(const SimulationOptions& options, const World& world,
+                        const sim::VehicleMotion& motion,
+                        const SimulationSummary& summary) {
+  nlohmann::json meta;
+  meta["generator"] = "zebrageo simulate";
+  meta["preset"] = options.preset;
+  meta["seed"] = options.seed;
+  meta["expect"] = "ok";
+  meta["render_images"] = options.render_images;
+  meta["options"] = OptionsToJson(options);
+  meta["origin"] = {options.origin_lat_deg, options.origin_lon_deg,
+                    options.origin_h_m};
+  meta["road"] = RoadJson(world);
+  nlohmann::json crossings = nlohmann::json::array();
+  for (const sim::Crossing& c : world.crossings) {
+    crossings.push_back(CrossingJson(world, c));
+  }
+  meta["crossings"] = crossings;
+  meta["faults"] = FaultsJson(world);
+  meta["trajectory_error"] = TrajectoryErrorJson(options, motion);
+  meta["counts"] = CountsJson(world, summary);
   return meta;
 }
 
-}  // namespace
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t)
+      .count();
+}
 
-SimulationSummary SimulateSurvey(
-    const SimulationOptions& options, const std::string& output_folder,
-    const std::function<void(int done, int total)>& progress) {
-  const std::string error = options.Check();
-  if (!error.empty()) throw std::invalid_argument(error);
-  const auto start = std::chrono::steady_clock::now();
-  auto seconds_since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t)
-        .count();
-  };
-  LOG(INFO) << "simulate: preset " << options.preset << ", seed "
-            << options.seed << ", " << options.road_length_m << " m";
-  const sim::SimulatedSurvey simulated = sim::MakeSimulatedSurvey(options);
+// The summary of what the simulation made, before writing and rendering.
+SimulationSummary SummaryOf(const sim::SimulatedSurvey& simulated) {
   const World& world = simulated.world;
   const sim::VehicleMotion& motion = simulated.motion;
-  const Rig& rig = simulated.rig;
-  const ExposureTable& table = simulated.exposures;
-  const RoadmarkDatabase& database = simulated.database;
-  const RoadmarkDatabase& truth = simulated.truth;
-  const LocalFrame& frame = simulated.frame;
-
   SimulationSummary summary;
   summary.num_trajectory_samples = static_cast<int>(motion.truth.size());
   summary.driven_length_m = world.s_drive_end - world.s_drive_start;
@@ -254,6 +268,125 @@ SimulationSummary SimulateSurvey(
     summary.max_vertical_error_m =
         std::max(summary.max_vertical_error_m, std::abs(e.z()));
   }
+  summary.num_exposures =
+      static_cast<int>(simulated.exposures.exposures.size());
+  summary.num_images = static_cast<int>(simulated.exposures.images.size());
+  summary.num_bands_in_street = static_cast<int>(simulated.truth.bands.size());
+  summary.num_bands_in_database =
+      static_cast<int>(simulated.database.bands.size());
+  summary.num_lines = static_cast<int>(simulated.database.lines.size());
+  return summary;
+}
+
+// The survey's files (all but the images and truth/meta.json), and the
+// truth beside them.
+void WriteSurveyFiles(const sim::SimulatedSurvey& simulated,
+                      const fs::path& folder) {
+  const sim::VehicleMotion& motion = simulated.motion;
+  WriteRig(simulated.rig, (folder / "rig.yaml").string());
+  WriteTrajectorySamples(motion.measured, (folder / "trajectory.csv").string());
+  WriteTrajectorySamples(motion.truth,
+                         (folder / "truth" / "trajectory.csv").string());
+  WriteExposures(simulated.exposures, simulated.rig,
+                 (folder / "exposures.csv").string());
+  WriteRoadmarks(simulated.database, (folder / "roadmarks.geojson").string());
+  WriteRoadmarks(simulated.truth,
+                 (folder / "truth" / "roadmarks.geojson").string());
+}
+
+int RenderThreads(const SimulationOptions& options, int total) {
+  return std::max(
+      1, std::min(total, options.threads > 0
+                             ? options.threads
+                             : static_cast<int>(std::max(
+                                   1u, std::thread::hardware_concurrency()))));
+}
+
+// Renders every image of the survey on RenderThreads() threads, each image
+// from its own seed (the images do not depend on the threads); fills the
+// summary's image counts and times.
+void RenderImages(const SimulationOptions& options,
+                  const sim::SimulatedSurvey& simulated, const fs::path& folder,
+                  const std::function<void(int done, int total)>& progress,
+                  SimulationSummary* summary) {
+  const Rig& rig = simulated.rig;
+  const ExposureTable& table = simulated.exposures;
+  // Poses exactly as a reader of truth/trajectory.csv interpolates them.
+  const Trajectory truth_trajectory(simulated.motion.truth, simulated.frame);
+  std::vector<sim::RayTable> ray_tables;
+  for (const RigCamera& c : rig.cameras) ray_tables.emplace_back(c.camera);
+  const sim::Renderer renderer(simulated.world,
+                               sim::RenderSettings::FromOptions(options));
+  const int total = summary->num_images;
+  const int workers = RenderThreads(options, total);
+  std::atomic<int> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex mutex;
+  int done = 0;
+  double cpu_seconds = 0.0;
+  std::exception_ptr first_error;
+  const auto render_start = std::chrono::steady_clock::now();
+  auto work = [&]() {
+    try {
+      while (!failed) {
+        const int index = next++;
+        if (index >= total) break;
+        const ExposureImage& item = table.images[index];
+        Pose pose;
+        CHECK(truth_trajectory.InterpolatePose(item.time, &pose));
+        const RigCamera& camera = rig.cameras[item.camera];
+        const Eigen::Isometry3d T_enu_cam =
+            pose.T_enu_body() * camera.T_body_cam;
+        const double s_hint =
+            simulated.motion.exposures[index / rig.cameras.size()].s_m;
+        sim::RenderStats stats;
+        const cv::Mat image = renderer.Render(
+            camera.camera, ray_tables[item.camera], T_enu_cam, s_hint,
+            sim::SubSeed(options.seed, 100, static_cast<uint64_t>(index)),
+            &stats);
+        std::vector<uchar> png;
+        CHECK(
+            cv::imencode(".png", image, png, {cv::IMWRITE_PNG_COMPRESSION, 3}));
+        WriteFileAtomically(
+            (folder / item.image).string(), [&png](std::ostream& out) {
+              out.write(reinterpret_cast<const char*>(png.data()),
+                        static_cast<std::streamsize>(png.size()));
+            });
+        std::lock_guard<std::mutex> lock(mutex);
+        ++done;
+        cpu_seconds += stats.seconds;
+        VLOG(1) << item.image << ": " << stats.rays << " rays, "
+                << stats.supersampled_pixels << " supersampled pixels, "
+                << stats.seconds << " s";
+        if (progress) progress(done, total);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!first_error) first_error = std::current_exception();
+      failed = true;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int w = 0; w < workers; ++w) threads.emplace_back(work);
+  for (std::thread& t : threads) t.join();
+  if (first_error) std::rethrow_exception(first_error);
+  summary->num_images_rendered = done;
+  summary->render_seconds = SecondsSince(render_start);
+  summary->seconds_per_image = done > 0 ? cpu_seconds / done : 0.0;
+}
+
+}  // namespace
+
+SimulationSummary SimulateSurvey(
+    const SimulationOptions& options, const std::string& output_folder,
+    const std::function<void(int done, int total)>& progress) {
+  const std::string error = options.Check();
+  if (!error.empty()) throw std::invalid_argument(error);
+  const auto start = std::chrono::steady_clock::now();
+  LOG(INFO) << "simulate: preset " << options.preset << ", seed "
+            << options.seed << ", " << options.road_length_m << " m";
+  const sim::SimulatedSurvey simulated = sim::MakeSimulatedSurvey(options);
+  SimulationSummary summary = SummaryOf(simulated);
 
   const fs::path folder(output_folder);
   std::error_code ec;
@@ -264,92 +397,14 @@ SimulationSummary SimulateSurvey(
     throw std::runtime_error("cannot create " + output_folder + ": " +
                              ec.message());
   }
-  summary.num_exposures = static_cast<int>(table.exposures.size());
-  summary.num_images = static_cast<int>(table.images.size());
-
-  WriteRig(rig, (folder / "rig.yaml").string());
-  WriteTrajectorySamples(motion.measured, (folder / "trajectory.csv").string());
-  WriteTrajectorySamples(motion.truth,
-                         (folder / "truth" / "trajectory.csv").string());
-  WriteExposures(table, rig, (folder / "exposures.csv").string());
-  WriteRoadmarks(database, (folder / "roadmarks.geojson").string());
-  WriteRoadmarks(truth, (folder / "truth" / "roadmarks.geojson").string());
-  summary.num_bands_in_street = static_cast<int>(truth.bands.size());
-  summary.num_bands_in_database = static_cast<int>(database.bands.size());
-  summary.num_lines = static_cast<int>(database.lines.size());
-
+  WriteSurveyFiles(simulated, folder);
   if (options.render_images) {
-    // Poses exactly as a reader of truth/trajectory.csv interpolates them.
-    const Trajectory truth_trajectory(motion.truth, frame);
-    std::vector<sim::RayTable> ray_tables;
-    for (const RigCamera& c : rig.cameras) ray_tables.emplace_back(c.camera);
-    const sim::Renderer renderer(world,
-                                 sim::RenderSettings::FromOptions(options));
-    const int total = summary.num_images;
-    const int workers = std::max(
-        1,
-        std::min(total, options.threads > 0
-                            ? options.threads
-                            : static_cast<int>(std::max(
-                                  1u, std::thread::hardware_concurrency()))));
-    std::atomic<int> next{0};
-    std::atomic<bool> failed{false};
-    std::mutex mutex;
-    int done = 0;
-    double cpu_seconds = 0.0;
-    std::exception_ptr first_error;
-    const auto render_start = std::chrono::steady_clock::now();
-    auto work = [&]() {
-      try {
-        while (!failed) {
-          const int index = next++;
-          if (index >= total) break;
-          const ExposureImage& item = table.images[index];
-          Pose pose;
-          CHECK(truth_trajectory.InterpolatePose(item.time, &pose));
-          const RigCamera& camera = rig.cameras[item.camera];
-          const Eigen::Isometry3d T_enu_cam =
-              pose.T_enu_body() * camera.T_body_cam;
-          const double s_hint =
-              motion.exposures[index / rig.cameras.size()].s_m;
-          sim::RenderStats stats;
-          const cv::Mat image = renderer.Render(
-              camera.camera, ray_tables[item.camera], T_enu_cam, s_hint,
-              sim::SubSeed(options.seed, 100, static_cast<uint64_t>(index)),
-              &stats);
-          std::vector<uchar> png;
-          CHECK(cv::imencode(".png", image, png,
-                             {cv::IMWRITE_PNG_COMPRESSION, 3}));
-          WriteFileAtomically(
-              (folder / item.image).string(), [&png](std::ostream& out) {
-                out.write(reinterpret_cast<const char*>(png.data()),
-                          static_cast<std::streamsize>(png.size()));
-              });
-          std::lock_guard<std::mutex> lock(mutex);
-          ++done;
-          cpu_seconds += stats.seconds;
-          VLOG(1) << item.image << ": " << stats.rays << " rays, "
-                  << stats.supersampled_pixels << " supersampled pixels, "
-                  << stats.seconds << " s";
-          if (progress) progress(done, total);
-        }
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!first_error) first_error = std::current_exception();
-        failed = true;
-      }
-    };
-    std::vector<std::thread> threads;
-    for (int w = 0; w < workers; ++w) threads.emplace_back(work);
-    for (std::thread& t : threads) t.join();
-    if (first_error) std::rethrow_exception(first_error);
-    summary.num_images_rendered = done;
-    summary.render_seconds = seconds_since(render_start);
-    summary.seconds_per_image = done > 0 ? cpu_seconds / done : 0.0;
+    RenderImages(options, simulated, folder, progress, &summary);
   }
 
-  summary.total_seconds = seconds_since(start);
-  const nlohmann::json meta = MetaJson(options, world, motion, summary);
+  summary.total_seconds = SecondsSince(start);
+  const nlohmann::json meta =
+      MetaJson(options, simulated.world, simulated.motion, summary);
   WriteFileAtomically(
       (folder / "truth" / "meta.json").string(),
       [&meta](std::ostream& out) { out << meta.dump(2) << "\n"; });
@@ -358,7 +413,7 @@ SimulationSummary SimulateSurvey(
       "zebrageo-sim-" + options.preset + "-seed" + std::to_string(options.seed);
   manifest.origin = simulated.origin;
   WriteManifest(manifest, (folder / "survey.yaml").string());
-  summary.total_seconds = seconds_since(start);
+  summary.total_seconds = SecondsSince(start);
   LOG(INFO) << summary.BriefReport();
   return summary;
 }

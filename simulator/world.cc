@@ -46,27 +46,30 @@ std::string CrossingId(int number) {
   return text;
 }
 
-void PlaceCrossings(const SimulationOptions& options, World* world) {
-  std::mt19937_64 rng(SubSeed(options.seed, kCrossingSeed));
-  const Road& road = world->road;
-  const int total = options.num_crossings + options.num_stale_crossings;
-  if (total == 0) return;
-  // Stratified positions: slot i holds one crossing, at least
-  // min_crossing_spacing_m from its neighbours. The first is seen from 25 m
-  // before it, the last up to 3 m after the end of the drive.
-  const double a = world->s_drive_start + 25.0;
-  const double b = world->s_drive_end + 3.0;
+// Stratified positions: slot i holds one crossing, at least
+// min_crossing_spacing_m from its neighbours. The first is seen from 25 m
+// before it, the last up to 3 m after the end of the drive.
+std::vector<double> CrossingPositions(const SimulationOptions& options,
+                                      const World& world, int total,
+                                      std::mt19937_64* rng) {
+  const double a = world.s_drive_start + 25.0;
+  const double b = world.s_drive_end + 3.0;
   const double slot = (b - a) / total;
   const double spacing = std::min(options.min_crossing_spacing_m, slot);
   std::vector<double> positions;
   for (int i = 0; i < total; ++i) {
     positions.push_back(a + i * slot + 0.5 * spacing +
-                        Uniform(&rng, 0.0, slot - spacing));
+                        Uniform(rng, 0.0, slot - spacing));
   }
-  // Which slots are stale (database only), and the faults of street ones.
+  return positions;
+}
+
+// Which slots are stale (database only), and the faults of street ones.
+std::vector<std::string> CrossingRoles(const SimulationOptions& options,
+                                       int total, std::mt19937_64* rng) {
   std::vector<int> order(total);
   std::iota(order.begin(), order.end(), 0);
-  std::shuffle(order.begin(), order.end(), rng);
+  std::shuffle(order.begin(), order.end(), *rng);
   std::vector<std::string> role(total, "ok");
   int next = 0;
   auto assign = [&](int count, const char* name) {
@@ -78,6 +81,127 @@ void PlaceCrossings(const SimulationOptions& options, World* world) {
   assign(options.num_missing_bands, "missing_band");
   assign(options.num_missing_end_bands, "missing_end_band");
   assign(options.num_missing_interior_bands, "missing_interior_band");
+  return role;
+}
+
+// The design of a crossing at s_design: skew, band length and count, the
+// bands' place across the road, and the database's offset. `fit` bands of
+// `period` fit between the kerbs.
+Crossing DesignCrossing(const SimulationOptions& options, const Road& road,
+                        double s_design, double period, int fit,
+                        std::mt19937_64* rng) {
+  Crossing c;
+  c.t = road.Tangent(s_design);
+  c.n = road.LeftNormal(s_design);
+  if (Bernoulli(rng, options.skew_probability) && options.max_skew_deg > 0.0) {
+    const double lo = std::min(8.0, options.max_skew_deg);
+    c.skew_deg = Uniform(rng, lo, options.max_skew_deg) *
+                 (Bernoulli(rng, 0.5) ? 1.0 : -1.0);
+  }
+  c.tan_skew = std::tan(c.skew_deg * kDegToRad);
+  c.band_length_m =
+      Uniform(rng, options.min_band_length_m, options.max_band_length_m);
+  c.band_width_m = options.band_width_m;
+  c.band_period_m = period;
+  const int most = std::min(options.max_bands_per_crossing, fit);
+  const int least = std::min(options.min_bands_per_crossing, most);
+  c.num_design_bands =
+      Bernoulli(rng, 0.6) ? most : UniformInt(rng, least, most);
+  const double width = road.width_m();
+  const double span = c.num_design_bands * options.band_width_m +
+                      (c.num_design_bands - 1) * options.band_gap_m;
+  const double free = width - 2.0 * kBandKerbMarginM - span;
+  c.first_offset_m = -0.5 * width + kBandKerbMarginM +
+                     (free > 0.3 ? Uniform(rng, 0.0, free) : 0.5 * free);
+  for (int k = 0; k < c.num_design_bands; ++k) {
+    c.ring_start.push_back(UniformInt(rng, 0, 3));
+  }
+  const double angle = Uniform(rng, 0.0, 2.0 * kPi);
+  const double magnitude = Uniform(rng, options.database_min_offset_m,
+                                   options.database_max_offset_m);
+  c.db_offset_enu =
+      Eigen::Vector3d(magnitude * std::cos(angle), magnitude * std::sin(angle),
+                      Uniform(rng, -options.database_max_offset_m,
+                              options.database_max_offset_m));
+  return c;
+}
+
+// What a role may use, drawn for every crossing whatever its role (so that
+// the draws of the next crossings do not depend on it).
+struct RoleDraws {
+  double shift_along = 0.0;
+  double shift_across = 0.0;
+  bool long_band_worn = false;
+  bool stop_line = false;
+};
+
+RoleDraws DrawRoleDraws(const SimulationOptions& options,
+                        std::mt19937_64* rng) {
+  RoleDraws draws;
+  draws.shift_along = options.repaint_shift_m * Uniform(rng, 0.6, 1.0) *
+                      (Bernoulli(rng, 0.5) ? 1.0 : -1.0);
+  draws.shift_across = options.repaint_shift_m * Uniform(rng, -0.4, 0.4);
+  draws.long_band_worn = Bernoulli(rng, 0.5);
+  draws.stop_line = Bernoulli(rng, options.stop_line_probability);
+  return draws;
+}
+
+// The crossing's faults for its role; the database's band gaps draw from
+// `gap_rng`.
+void ApplyRole(const std::string& role, const RoleDraws& draws,
+               std::mt19937_64* gap_rng, Crossing* crossing) {
+  Crossing& c = *crossing;
+  c.num_street_bands = c.num_design_bands;
+  c.num_db_bands = c.num_design_bands;
+  if (role == "stale") {
+    c.in_street = false;
+  } else if (role == "missing") {
+    c.in_db = false;
+  } else if (role == "repainted") {
+    c.repainted = true;
+    c.repaint_shift_xy = draws.shift_along * c.t + draws.shift_across * c.n;
+  } else if (role == "missing_band") {
+    // Always the last band, so both files number 1..N consecutively.
+    if (draws.long_band_worn) {
+      c.missing_band_kind = "worn_in_street";
+      c.num_street_bands = c.num_design_bands - 1;
+    } else {
+      c.missing_band_kind = "missing_in_db";
+      c.num_db_bands = c.num_design_bands - 1;
+    }
+  } else if (role == "missing_end_band" && c.num_design_bands >= 2) {
+    c.missing_band_kind = "end_missing_in_db";
+    c.db_missing_bands = {Bernoulli(gap_rng, 0.5) ? 1 : c.num_design_bands};
+  } else if (role == "missing_interior_band" && c.num_design_bands >= 3) {
+    c.missing_band_kind = "interior_missing_in_db";
+    c.db_missing_bands = {UniformInt(gap_rng, 2, c.num_design_bands - 1)};
+  }
+}
+
+// The crossing's origin and road position after a repaint, and the span of
+// road its bands cover.
+void PlaceCrossingOnRoad(const Road& road, double s_design,
+                         Crossing* crossing) {
+  Crossing& c = *crossing;
+  c.origin_xy = road.Centre(s_design) + c.repaint_shift_xy;
+  c.s_m = s_design + c.repaint_shift_xy.dot(c.t);
+  const double o_end = c.first_offset_m +
+                       (c.num_design_bands - 1) * c.band_period_m +
+                       c.band_width_m;
+  const double skew_lo = std::min(c.first_offset_m, o_end) * c.tan_skew;
+  const double skew_hi = std::max(c.first_offset_m, o_end) * c.tan_skew;
+  c.s_min = c.s_m + std::min(skew_lo, skew_hi) - 0.5 * c.band_length_m;
+  c.s_max = c.s_m + std::max(skew_lo, skew_hi) + 0.5 * c.band_length_m;
+}
+
+void PlaceCrossings(const SimulationOptions& options, World* world) {
+  std::mt19937_64 rng(SubSeed(options.seed, kCrossingSeed));
+  const Road& road = world->road;
+  const int total = options.num_crossings + options.num_stale_crossings;
+  if (total == 0) return;
+  const std::vector<double> positions =
+      CrossingPositions(options, *world, total, &rng);
+  const std::vector<std::string> role = CrossingRoles(options, total, &rng);
   // The database's band gaps draw from their own generator: the crossings
   // of the other presets do not change with these knobs.
   std::mt19937_64 gap_rng(SubSeed(options.seed, kCrossingSeed, 7));
@@ -88,85 +212,15 @@ void PlaceCrossings(const SimulationOptions& options, World* world) {
       (width - 2.0 * kBandKerbMarginM + options.band_gap_m) / period));
   int number = 100 + UniformInt(&rng, 1, 20);
   for (int i = 0; i < total; ++i) {
-    Crossing c;
     number += UniformInt(&rng, 1, 3);  // ids are labels, with gaps
+    const double s_design = positions[i];
+    Crossing c = DesignCrossing(options, road, s_design, period, fit, &rng);
     c.id = CrossingId(number);
     c.salt = SubSeed(options.seed, kCrossingSeed, 1000 + i);
-    const double s_design = positions[i];
-    c.t = road.Tangent(s_design);
-    c.n = road.LeftNormal(s_design);
-    if (Bernoulli(&rng, options.skew_probability) &&
-        options.max_skew_deg > 0.0) {
-      const double lo = std::min(8.0, options.max_skew_deg);
-      c.skew_deg = Uniform(&rng, lo, options.max_skew_deg) *
-                   (Bernoulli(&rng, 0.5) ? 1.0 : -1.0);
-    }
-    c.tan_skew = std::tan(c.skew_deg * kDegToRad);
-    c.band_length_m =
-        Uniform(&rng, options.min_band_length_m, options.max_band_length_m);
-    c.band_width_m = options.band_width_m;
-    c.band_period_m = period;
-    const int most = std::min(options.max_bands_per_crossing, fit);
-    const int least = std::min(options.min_bands_per_crossing, most);
-    c.num_design_bands =
-        Bernoulli(&rng, 0.6) ? most : UniformInt(&rng, least, most);
-    const double span = c.num_design_bands * options.band_width_m +
-                        (c.num_design_bands - 1) * options.band_gap_m;
-    const double free = width - 2.0 * kBandKerbMarginM - span;
-    c.first_offset_m = -0.5 * width + kBandKerbMarginM +
-                       (free > 0.3 ? Uniform(&rng, 0.0, free) : 0.5 * free);
-    for (int k = 0; k < c.num_design_bands; ++k) {
-      c.ring_start.push_back(UniformInt(&rng, 0, 3));
-    }
-    const double angle = Uniform(&rng, 0.0, 2.0 * kPi);
-    const double magnitude = Uniform(&rng, options.database_min_offset_m,
-                                     options.database_max_offset_m);
-    c.db_offset_enu = Eigen::Vector3d(
-        magnitude * std::cos(angle), magnitude * std::sin(angle),
-        Uniform(&rng, -options.database_max_offset_m,
-                options.database_max_offset_m));
-    const double shift_along = options.repaint_shift_m *
-                               Uniform(&rng, 0.6, 1.0) *
-                               (Bernoulli(&rng, 0.5) ? 1.0 : -1.0);
-    const double shift_across =
-        options.repaint_shift_m * Uniform(&rng, -0.4, 0.4);
-    const bool long_band_worn = Bernoulli(&rng, 0.5);
-    const bool stop_line = Bernoulli(&rng, options.stop_line_probability);
-
-    c.num_street_bands = c.num_design_bands;
-    c.num_db_bands = c.num_design_bands;
-    if (role[i] == "stale") {
-      c.in_street = false;
-    } else if (role[i] == "missing") {
-      c.in_db = false;
-    } else if (role[i] == "repainted") {
-      c.repainted = true;
-      c.repaint_shift_xy = shift_along * c.t + shift_across * c.n;
-    } else if (role[i] == "missing_band") {
-      // Always the last band, so both files number 1..N consecutively.
-      if (long_band_worn) {
-        c.missing_band_kind = "worn_in_street";
-        c.num_street_bands = c.num_design_bands - 1;
-      } else {
-        c.missing_band_kind = "missing_in_db";
-        c.num_db_bands = c.num_design_bands - 1;
-      }
-    } else if (role[i] == "missing_end_band" && c.num_design_bands >= 2) {
-      c.missing_band_kind = "end_missing_in_db";
-      c.db_missing_bands = {Bernoulli(&gap_rng, 0.5) ? 1 : c.num_design_bands};
-    } else if (role[i] == "missing_interior_band" && c.num_design_bands >= 3) {
-      c.missing_band_kind = "interior_missing_in_db";
-      c.db_missing_bands = {UniformInt(&gap_rng, 2, c.num_design_bands - 1)};
-    }
-    c.origin_xy = road.Centre(s_design) + c.repaint_shift_xy;
-    c.s_m = s_design + c.repaint_shift_xy.dot(c.t);
-    const double o_end =
-        c.first_offset_m + (c.num_design_bands - 1) * period + c.band_width_m;
-    const double skew_lo = std::min(c.first_offset_m, o_end) * c.tan_skew;
-    const double skew_hi = std::max(c.first_offset_m, o_end) * c.tan_skew;
-    c.s_min = c.s_m + std::min(skew_lo, skew_hi) - 0.5 * c.band_length_m;
-    c.s_max = c.s_m + std::max(skew_lo, skew_hi) + 0.5 * c.band_length_m;
-    c.stop_line = stop_line && c.in_street;
+    const RoleDraws draws = DrawRoleDraws(options, &rng);
+    ApplyRole(role[i], draws, &gap_rng, &c);
+    PlaceCrossingOnRoad(road, s_design, &c);
+    c.stop_line = draws.stop_line && c.in_street;
     world->crossings.push_back(c);
   }
 }

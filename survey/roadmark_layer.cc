@@ -14,6 +14,7 @@
 #include <set>
 #include <utility>
 
+#include "survey/band_degeneracy.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"

@@ -53,9 +53,6 @@ RoadmarkDatabase ReadRoadmarks(const std::string& path,
                                const std::string& display_name);
 RoadmarkDatabase ParseRoadmarks(const std::string& text,
                                 const std::string& display_name);
-// "" or why four corners make no usable band (repeated corners, zero area,
-// self-intersecting), as ReadRoadmarks checks each band.
-std::string BandDegeneracy(const std::array<Geodetic, 4>& corners);
 // Writes a database atomically: rings closed, corners in the stored order,
 // one feature per line, numbers with every digit (round trip exact).
 void WriteRoadmarks(const RoadmarkDatabase& database, const std::string& path);

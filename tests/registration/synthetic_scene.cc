@@ -92,6 +92,202 @@ std::array<Eigen::Vector3d, 4> BandCorners(double x_centre, double y_centre,
           c - along + across};
 }
 
+// The scene's random draws: one generator, drawn in scene order.
+struct SceneRandom {
+  explicit SceneRandom(int seed) : rng(seed) {}
+  std::mt19937 rng;
+  std::normal_distribution<double> normal{0.0, 1.0};
+  std::uniform_real_distribution<double> uniform{0.0, 1.0};
+};
+
+// A band of the street (truth), as the drive sees it.
+struct StreetBand {
+  std::string crossing_id;
+  int band;
+  int group;
+  std::array<Eigen::Vector3d, 4> corners;
+  double hidden_beyond_x = -std::numeric_limits<double>::infinity();
+};
+
+// The crossings' bands: the street's in scene->truth (returned for the
+// drive) and the database's, offset per crossing and noisy per vertex, in
+// scene->database.
+std::vector<StreetBand> PaintCrossings(const SyntheticSceneOptions& options,
+                                       SceneRandom* random,
+                                       SyntheticScene* scene) {
+  std::mt19937& rng = random->rng;
+  std::normal_distribution<double>& normal = random->normal;
+  std::uniform_real_distribution<double>& uniform = random->uniform;
+  std::vector<StreetBand> street;
+  for (size_t c = 0; c < options.crossings.size(); ++c) {
+    const SyntheticCrossingSpec& spec = options.crossings[c];
+    char id[16];
+    std::snprintf(id, sizeof(id), "C%02d", static_cast<int>(c + 1));
+    const double y0 = spec.y0_m.value_or(options.road_y0_m);
+    const double y_mid = y0 + 0.5 * spec.bands * kBandPeriodM;
+    const Eigen::Vector3d offset(
+        options.database_offset_m * (2.0 * uniform(rng) - 1.0),
+        options.database_offset_m * (2.0 * uniform(rng) - 1.0), 0.0);
+    for (int n = 1; n <= spec.bands; ++n) {
+      const double y = y0 + (n - 0.5) * kBandPeriodM;
+      std::array<Eigen::Vector3d, 4> corners =
+          BandCorners(spec.x_m + std::tan(spec.skew_rad) * (y - y_mid), y,
+                      spec.band_length_m, spec.skew_rad);
+      std::rotate(corners.begin(),
+                  corners.begin() + static_cast<int>(uniform(rng) * 4) % 4,
+                  corners.end());
+      const bool in_street =
+          spec.in_street &&
+          std::find(spec.street_lacks.begin(), spec.street_lacks.end(), n) ==
+              spec.street_lacks.end();
+      const bool in_database =
+          spec.in_database &&
+          std::find(spec.database_lacks.begin(), spec.database_lacks.end(),
+                    n) == spec.database_lacks.end();
+      if (in_street) {
+        scene->truth[{id, n}] = corners;
+        StreetBand street_band{id, n, static_cast<int>(c + 1), corners};
+        if (n <= spec.occluded_bands) {
+          street_band.hidden_beyond_x = spec.x_m - spec.occluded_beyond_m;
+        }
+        street.push_back(street_band);
+      }
+      if (in_database) {
+        RoadmarkBand band;
+        band.crossing_id = id;
+        band.band = n;
+        band.sigma_xy_m = 0.05;
+        band.sigma_z_m = 0.1;
+        for (int k = 0; k < 4; ++k) {
+          Eigen::Vector3d p = corners[k] + offset;
+          p.head<2>() += spec.database_shift_m;
+          p.x() += options.database_vertex_noise_m * normal(rng);
+          p.y() += options.database_vertex_noise_m * normal(rng);
+          band.corners[k] = scene->frame.GeodeticFromEnu(p);
+        }
+        scene->database.bands.push_back(band);
+      }
+    }
+  }
+  return street;
+}
+
+// The measured pose at time t: the true one with the drifting position
+// error and heading error of the options.
+Pose MeasuredPoseAt(const SyntheticSceneOptions& options, const Pose& truth,
+                    const Eigen::Matrix3d& R_true, double t) {
+  const double angle =
+      options.drift_phase_rad + options.drift_turn_rate_rad_per_s * t;
+  const Eigen::Vector2d drift =
+      options.drift_m * Eigen::Vector2d(std::cos(angle), std::sin(angle)) +
+      options.constant_shift_m;
+  const double heading_error =
+      options.heading_drift_rad * std::sin(0.05 * t + 0.3);
+  Pose measured;
+  measured.q_enu_body = Eigen::Quaterniond(RotationZ3(heading_error) * R_true);
+  measured.p_enu = truth.p_enu;
+  measured.p_enu.head<2>() += drift;
+  return measured;
+}
+
+// Band `enu` as reconstructed from the true pose (R_true, p_enu_true):
+// vertices in the body frame, with noise, from any starting vertex, in
+// either sense (the matcher must not care).
+ObservedBand ObservedBandOf(const SyntheticSceneOptions& options,
+                            const Eigen::Matrix3d& R_true,
+                            const Eigen::Vector3d& p_enu_true,
+                            const std::array<Eigen::Vector3d, 4>& enu,
+                            int64_t band_id, SceneRandom* random) {
+  std::mt19937& rng = random->rng;
+  std::normal_distribution<double>& normal = random->normal;
+  std::uniform_real_distribution<double>& uniform = random->uniform;
+  ObservedBand band;
+  band.band_id = band_id;
+  const int start = static_cast<int>(uniform(rng) * 4) % 4;
+  const bool reverse = uniform(rng) < 0.5;
+  for (int k = 0; k < 4; ++k) {
+    const int src = reverse ? (start - k + 4) % 4 : (start + k) % 4;
+    const Eigen::Vector3d p_body = R_true.transpose() * (enu[src] - p_enu_true);
+    band.p_body[k] =
+        p_body + options.vertex_noise_m *
+                     Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    band.vertex[k] = k;
+  }
+  return band;
+}
+
+// A band-shaped false detection somewhere ahead of x, any direction.
+std::array<Eigen::Vector3d, 4> FalseBandCorners(
+    const SyntheticSceneOptions& options, double x, SceneRandom* random) {
+  std::mt19937& rng = random->rng;
+  std::uniform_real_distribution<double>& uniform = random->uniform;
+  const double fx = x + 5.0 + 7.0 * uniform(rng);
+  const double fy = options.lane_y_m + 6.0 * (uniform(rng) - 0.5);
+  const double yaw = kPi * uniform(rng);
+  std::array<Eigen::Vector3d, 4> corners =
+      BandCorners(0.0, 0.0, 2.5 + 3.0 * uniform(rng), 0.0);
+  for (Eigen::Vector3d& p : corners) {
+    p = RotationZ3(yaw) * p + Eigen::Vector3d(fx, fy, 0.0);
+  }
+  return corners;
+}
+
+// The exposure at time t, the vehicle at x: its true and measured poses,
+// and the groups of bands reconstructed there (the street's bands it fully
+// sees, unless missed or hidden, and perhaps a false band).
+void ObserveExposure(const SyntheticSceneOptions& options,
+                     const std::vector<StreetBand>& street, double t, double x,
+                     int64_t exposure_id, int64_t* band_id, SceneRandom* random,
+                     SyntheticScene* scene) {
+  std::mt19937& rng = random->rng;
+  std::uniform_real_distribution<double>& uniform = random->uniform;
+  const Eigen::Matrix3d R_true = EastboundEnuFromBody();
+  Pose truth;
+  truth.q_enu_body = Eigen::Quaterniond(R_true);
+  truth.p_enu = Eigen::Vector3d(x, options.lane_y_m, kBodyHeightM);
+  const Pose measured = MeasuredPoseAt(options, truth, R_true, t);
+  scene->true_pose[exposure_id] = truth;
+  scene->exposures.push_back({exposure_id, t, measured});
+
+  std::map<int, CrossingObservation> groups;
+  auto observe = [&](int group, const std::array<Eigen::Vector3d, 4>& enu,
+                     const std::pair<std::string, int>* key) {
+    CrossingObservation& obs = groups[group];
+    obs.exposure_id = exposure_id;
+    obs.group_id = group;
+    obs.time_s = t;
+    obs.pose = measured;
+    obs.sd_horizontal_m = 0.05;
+    obs.bands.push_back(ObservedBandOf(options, R_true, truth.p_enu, enu,
+                                       (*band_id)++, random));
+    if (key != nullptr) {
+      scene->band_truth[{exposure_id, obs.bands.back().band_id}] = *key;
+    }
+  };
+  for (const StreetBand& band : street) {
+    if (!FullyVisible(scene->rig, scene->rig.stereo_pairs[0], truth,
+                      band.corners, options.max_range_m, 5.0)) {
+      continue;
+    }
+    if (uniform(rng) < options.miss_probability) continue;
+    if (x < band.hidden_beyond_x) continue;  // behind a parked vehicle
+    const std::pair<std::string, int> key(band.crossing_id, band.band);
+    observe(band.group, band.corners, &key);
+  }
+  if (uniform(rng) < options.false_band_probability) {
+    const std::array<Eigen::Vector3d, 4> corners =
+        FalseBandCorners(options, x, random);
+    // Either alone or inside the group of a crossing seen.
+    const int group = !groups.empty() && uniform(rng) < 0.5
+                          ? groups.begin()->first
+                          : 900 + static_cast<int>(exposure_id % 7);
+    observe(group, corners, nullptr);
+  }
+  for (auto& [group, obs] : groups) {
+    scene->observations.push_back(std::move(obs));
+  }
+}
+
 }  // namespace
 
 MatchInput SyntheticScene::Input(const RoadmarkIndex& index) const {
@@ -123,158 +319,26 @@ std::vector<SyntheticCrossingSpec> RandomCrossings(int count, double spacing_m,
 
 SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   SyntheticScene scene;
-  std::mt19937 rng(options.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  SceneRandom random(options.seed);
   scene.rig =
       ForwardStereoRig(options.horizontal_fov_deg, options.pitch_down_deg);
-
   // Bands: truth (the street) and the database.
-  struct StreetBand {
-    std::string crossing_id;
-    int band;
-    int group;
-    std::array<Eigen::Vector3d, 4> corners;
-    double hidden_beyond_x = -std::numeric_limits<double>::infinity();
-  };
-  std::vector<StreetBand> street;
+  const std::vector<StreetBand> street =
+      PaintCrossings(options, &random, &scene);
   double last_x = 0.0;
-  for (size_t c = 0; c < options.crossings.size(); ++c) {
-    const SyntheticCrossingSpec& spec = options.crossings[c];
+  for (const SyntheticCrossingSpec& spec : options.crossings) {
     last_x = std::max(last_x, spec.x_m);
-    char id[16];
-    std::snprintf(id, sizeof(id), "C%02d", static_cast<int>(c + 1));
-    const double y0 = spec.y0_m.value_or(options.road_y0_m);
-    const double y_mid = y0 + 0.5 * spec.bands * kBandPeriodM;
-    const Eigen::Vector3d offset(
-        options.database_offset_m * (2.0 * uniform(rng) - 1.0),
-        options.database_offset_m * (2.0 * uniform(rng) - 1.0), 0.0);
-    for (int n = 1; n <= spec.bands; ++n) {
-      const double y = y0 + (n - 0.5) * kBandPeriodM;
-      std::array<Eigen::Vector3d, 4> corners =
-          BandCorners(spec.x_m + std::tan(spec.skew_rad) * (y - y_mid), y,
-                      spec.band_length_m, spec.skew_rad);
-      std::rotate(corners.begin(),
-                  corners.begin() + static_cast<int>(uniform(rng) * 4) % 4,
-                  corners.end());
-      const bool in_street =
-          spec.in_street &&
-          std::find(spec.street_lacks.begin(), spec.street_lacks.end(), n) ==
-              spec.street_lacks.end();
-      const bool in_database =
-          spec.in_database &&
-          std::find(spec.database_lacks.begin(), spec.database_lacks.end(),
-                    n) == spec.database_lacks.end();
-      if (in_street) {
-        scene.truth[{id, n}] = corners;
-        StreetBand street_band{id, n, static_cast<int>(c + 1), corners};
-        if (n <= spec.occluded_bands) {
-          street_band.hidden_beyond_x = spec.x_m - spec.occluded_beyond_m;
-        }
-        street.push_back(street_band);
-      }
-      if (in_database) {
-        RoadmarkBand band;
-        band.crossing_id = id;
-        band.band = n;
-        band.sigma_xy_m = 0.05;
-        band.sigma_z_m = 0.1;
-        for (int k = 0; k < 4; ++k) {
-          Eigen::Vector3d p = corners[k] + offset;
-          p.head<2>() += spec.database_shift_m;
-          p.x() += options.database_vertex_noise_m * normal(rng);
-          p.y() += options.database_vertex_noise_m * normal(rng);
-          band.corners[k] = scene.frame.GeodeticFromEnu(p);
-        }
-        scene.database.bands.push_back(band);
-      }
-    }
   }
-
   // Drive.
   const double end_x = options.end_x_m != 0.0 ? options.end_x_m : last_x + 40.0;
-  const Eigen::Matrix3d R_true = EastboundEnuFromBody();
   int64_t band_id = 1;
   int64_t exposure_id = 1000;
   for (double t = 0.0;; t += options.exposure_interval_s) {
     const double x = options.start_x_m + options.speed_m_per_s * t;
     if (x > end_x) break;
     exposure_id += 3;  // labels, not indices
-    Pose truth;
-    truth.q_enu_body = Eigen::Quaterniond(R_true);
-    truth.p_enu = Eigen::Vector3d(x, options.lane_y_m, kBodyHeightM);
-    const double angle =
-        options.drift_phase_rad + options.drift_turn_rate_rad_per_s * t;
-    const Eigen::Vector2d drift =
-        options.drift_m * Eigen::Vector2d(std::cos(angle), std::sin(angle)) +
-        options.constant_shift_m;
-    const double heading_error =
-        options.heading_drift_rad * std::sin(0.05 * t + 0.3);
-    Pose measured;
-    measured.q_enu_body =
-        Eigen::Quaterniond(RotationZ3(heading_error) * R_true);
-    measured.p_enu = truth.p_enu;
-    measured.p_enu.head<2>() += drift;
-    scene.true_pose[exposure_id] = truth;
-    scene.exposures.push_back({exposure_id, t, measured});
-
-    std::map<int, CrossingObservation> groups;
-    auto observe = [&](int group, const std::array<Eigen::Vector3d, 4>& enu,
-                       const std::pair<std::string, int>* key) {
-      CrossingObservation& obs = groups[group];
-      obs.exposure_id = exposure_id;
-      obs.group_id = group;
-      obs.time_s = t;
-      obs.pose = measured;
-      obs.sd_horizontal_m = 0.05;
-      ObservedBand band;
-      band.band_id = band_id++;
-      // Any starting vertex, either sense: the matcher must not care.
-      const int start = static_cast<int>(uniform(rng) * 4) % 4;
-      const bool reverse = uniform(rng) < 0.5;
-      for (int k = 0; k < 4; ++k) {
-        const int src = reverse ? (start - k + 4) % 4 : (start + k) % 4;
-        const Eigen::Vector3d p_body =
-            R_true.transpose() * (enu[src] - truth.p_enu);
-        band.p_body[k] =
-            p_body + options.vertex_noise_m *
-                         Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-        band.vertex[k] = k;
-      }
-      obs.bands.push_back(band);
-      if (key != nullptr) {
-        scene.band_truth[{exposure_id, band.band_id}] = *key;
-      }
-    };
-    for (const StreetBand& band : street) {
-      if (!FullyVisible(scene.rig, scene.rig.stereo_pairs[0], truth,
-                        band.corners, options.max_range_m, 5.0)) {
-        continue;
-      }
-      if (uniform(rng) < options.miss_probability) continue;
-      if (x < band.hidden_beyond_x) continue;  // behind a parked vehicle
-      const std::pair<std::string, int> key(band.crossing_id, band.band);
-      observe(band.group, band.corners, &key);
-    }
-    if (uniform(rng) < options.false_band_probability) {
-      // A band-shaped false detection somewhere ahead, any direction.
-      const double fx = x + 5.0 + 7.0 * uniform(rng);
-      const double fy = options.lane_y_m + 6.0 * (uniform(rng) - 0.5);
-      const double yaw = kPi * uniform(rng);
-      std::array<Eigen::Vector3d, 4> corners =
-          BandCorners(0.0, 0.0, 2.5 + 3.0 * uniform(rng), 0.0);
-      for (Eigen::Vector3d& p : corners) {
-        p = RotationZ3(yaw) * p + Eigen::Vector3d(fx, fy, 0.0);
-      }
-      // Either alone or inside the group of a crossing seen.
-      const int group = !groups.empty() && uniform(rng) < 0.5
-                            ? groups.begin()->first
-                            : 900 + static_cast<int>(exposure_id % 7);
-      observe(group, corners, nullptr);
-    }
-    for (auto& [group, obs] : groups) {
-      scene.observations.push_back(std::move(obs));
-    }
+    ObserveExposure(options, street, t, x, exposure_id, &band_id, &random,
+                    &scene);
   }
   return scene;
 }

@@ -142,6 +142,209 @@ Rig MakeRig() {
   return rig;
 }
 
+// The drift of the measured trajectory: east, north, up, heading, roll and
+// pitch, drawn from `rng` in this order.
+struct TrajectoryDrift {
+  Drift e, n, u, heading, roll, pitch;
+};
+
+TrajectoryDrift DrawTrajectoryDrift(const SyntheticSurveyOptions& options,
+                                    std::mt19937_64* rng) {
+  Drift drift_e(options.drift_horizontal_m / std::sqrt(2.0),
+                options.drift_period_s, rng);
+  Drift drift_n(options.drift_horizontal_m / std::sqrt(2.0),
+                options.drift_period_s, rng);
+  Drift drift_u(options.drift_vertical_m, options.drift_period_s, rng);
+  Drift drift_heading(options.heading_drift_deg * kDegToRad,
+                      options.drift_period_s, rng);
+  Drift drift_roll(options.tilt_drift_deg * kDegToRad, options.drift_period_s,
+                   rng);
+  Drift drift_pitch(options.tilt_drift_deg * kDegToRad, options.drift_period_s,
+                    rng);
+  return {drift_e, drift_n, drift_u, drift_heading, drift_roll, drift_pitch};
+}
+
+// The true and the measured (drifting) trajectory over `duration` from t0,
+// the vehicle at road position 20 m + speed * t.
+void AddTrajectorySamples(const SyntheticSurveyOptions& options,
+                          const Road& road, const Centreline& centreline,
+                          const TrajectoryDrift& drift, double t0,
+                          double duration, SyntheticSurvey* survey) {
+  const double imu_height = 1.0;
+  const int num_samples =
+      static_cast<int>(std::ceil(duration * options.trajectory_rate_hz)) + 1;
+  const Eigen::Vector3d sd_enu(0.03, 0.03, 0.05);
+  const Eigen::Vector3d sd_att(0.01 * kDegToRad, 0.01 * kDegToRad,
+                               0.03 * kDegToRad);
+  for (int i = 0; i < num_samples; ++i) {
+    const double t = i / options.trajectory_rate_hz;
+    const double s = 20.0 + options.speed_mps * t;
+    const double theta = road.Theta(s);
+    Attitude attitude;
+    attitude.heading = 0.5 * kPi - theta;
+    attitude.pitch = std::atan(road.Grade(s));
+    attitude.roll = 0.002 * std::sin(2.0 * kPi * 1.5 * t);
+    Pose truth;
+    truth.p_enu = centreline.Point(s, 0.0) + Eigen::Vector3d(0, 0, imu_height);
+    truth.q_enu_body = Eigen::Quaterniond(RotationEnuFromNed() *
+                                          RotationNedFromBody(attitude));
+    survey->truth_samples.push_back(
+        SampleFromPose(t0 + t, truth, survey->frame, sd_enu, sd_att));
+    Pose measured;
+    measured.p_enu =
+        truth.p_enu + Eigen::Vector3d(drift.e(t), drift.n(t), drift.u(t));
+    // Attitude error in the body frame: R_meas = R_true * Exp(error).
+    const Eigen::Vector3d error(drift.roll(t), drift.pitch(t),
+                                drift.heading(t));
+    const double angle = error.norm();
+    const Eigen::Quaterniond dq =
+        angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, error / angle))
+                  : Eigen::Quaterniond::Identity();
+    measured.q_enu_body = (truth.q_enu_body * dq).normalized();
+    survey->measured_samples.push_back(
+        SampleFromPose(t0 + t, measured, survey->frame, sd_enu, sd_att));
+  }
+}
+
+// Crossings every crossing_spacing_m up to s_end: bands across the road,
+// long sides along it, corners counter-clockwise seen from above. The
+// database's copy is offset per crossing and noisy per vertex.
+void AddCrossings(const SyntheticSurveyOptions& options,
+                  const Centreline& centreline, double s_end,
+                  std::mt19937_64* rng,
+                  std::normal_distribution<double>* normal,
+                  SyntheticSurvey* survey) {
+  int num_crossings = 0;
+  for (double s = 60.0; s < s_end; s += options.crossing_spacing_m) {
+    const int crossing = num_crossings++;
+    const Eigen::Vector3d offset(options.database_offset_m * (*normal)(*rng),
+                                 options.database_offset_m * (*normal)(*rng),
+                                 options.database_offset_m * (*normal)(*rng));
+    for (int b = 0; b < options.bands_per_crossing; ++b) {
+      const double l = (b - 0.5 * (options.bands_per_crossing - 1)) * 1.0;
+      const std::array<Eigen::Vector3d, 4> corners = {
+          centreline.Point(s - 1.5, l - 0.25),
+          centreline.Point(s + 1.5, l - 0.25),
+          centreline.Point(s + 1.5, l + 0.25),
+          centreline.Point(s - 1.5, l + 0.25)};
+      RoadmarkBand truth_band, db_band;
+      truth_band.crossing_id = db_band.crossing_id =
+          "X" + std::to_string(crossing + 1);
+      truth_band.band = db_band.band = b + 1;
+      truth_band.sigma_xy_m = db_band.sigma_xy_m = options.database_sigma_xy_m;
+      truth_band.sigma_z_m = db_band.sigma_z_m = options.database_sigma_z_m;
+      for (int v = 0; v < 4; ++v) {
+        truth_band.corners[v] = survey->frame.GeodeticFromEnu(corners[v]);
+        const Eigen::Vector3d noisy =
+            corners[v] + offset +
+            Eigen::Vector3d(options.database_sigma_xy_m * (*normal)(*rng),
+                            options.database_sigma_xy_m * (*normal)(*rng),
+                            options.database_sigma_z_m * (*normal)(*rng));
+        db_band.corners[v] = survey->frame.GeodeticFromEnu(noisy);
+      }
+      survey->truth_database.bands.push_back(truth_band);
+      survey->database.bands.push_back(db_band);
+    }
+  }
+}
+
+// num_exposures exposures of both cameras, exposure_interval_s apart from
+// `start`; ids are labels, 7 apart.
+ExposureTable ExposuresOf(const SyntheticSurveyOptions& options, double start) {
+  ExposureTable table;
+  for (int e = 0; e < options.num_exposures; ++e) {
+    const double time = start + e * options.exposure_interval_s;
+    const int64_t exposure_id = 1000 + 7 * e;
+    Exposure exposure;
+    exposure.exposure_id = exposure_id;
+    exposure.time = time;
+    for (int c = 0; c < 2; ++c) {
+      ExposureImage image;
+      image.exposure_id = exposure_id;
+      image.time = time;
+      image.camera = c;
+      image.image = std::string("images/") + (c == 0 ? "left" : "right") + "/" +
+                    std::to_string(exposure_id) + ".png";
+      exposure.image_of_camera.push_back(static_cast<int>(table.images.size()));
+      table.images.push_back(image);
+    }
+    table.exposures.push_back(exposure);
+  }
+  return table;
+}
+
+// The observations of point X (ENU) in the images of exposures e to
+// e + tie_track_exposures - 1 that see it within 40 m, with pixel noise.
+TieTrack TieTrackOf(const SyntheticSurveyOptions& options,
+                    const SyntheticSurvey& survey,
+                    const Trajectory& truth_trajectory,
+                    const Eigen::Vector3d& X, int e, std::mt19937_64* rng,
+                    std::normal_distribution<double>* normal) {
+  TieTrack track;
+  for (int f = e;
+       f < std::min(options.num_exposures, e + options.tie_track_exposures);
+       ++f) {
+    const Exposure& exposure = survey.exposures.exposures[f];
+    Pose pose;
+    CHECK(truth_trajectory.InterpolatePose(exposure.time, &pose));
+    for (int c = 0; c < 2; ++c) {
+      const RigCamera& camera = survey.rig.cameras[c];
+      const Eigen::Vector3d p_cam =
+          (pose.T_enu_body() * camera.T_body_cam).inverse() * X;
+      Eigen::Vector2d uv;
+      if (p_cam.z() < 2.0 || p_cam.norm() > 40.0 ||
+          !camera.camera.Project(p_cam, &uv) ||
+          !camera.camera.IsInImage(uv, 5.0)) {
+        continue;
+      }
+      uv += options.tie_noise_px *
+            Eigen::Vector2d((*normal)(*rng), (*normal)(*rng));
+      track.observations.push_back(
+          {exposure.image_of_camera[c], exposure.time, c, uv});
+    }
+  }
+  return track;
+}
+
+// Ideal tie points: per exposure, points on the road ahead and on the
+// facades, tracked over the next exposures, each placed as triangulated
+// with the drifting trajectory.
+void AddTiePoints(const SyntheticSurveyOptions& options,
+                  const Centreline& centreline,
+                  const Trajectory& truth_trajectory, double t0,
+                  std::mt19937_64* rng,
+                  std::normal_distribution<double>* normal,
+                  SyntheticSurvey* survey) {
+  const Trajectory measured_trajectory(survey->measured_samples, survey->frame);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int e = 0;
+       e < options.num_exposures && options.tie_points_per_exposure > 0; ++e) {
+    const double time = survey->exposures.exposures[e].time;
+    const double s0 = 20.0 + options.speed_mps * (time - t0);
+    Pose true_pose, measured_pose;
+    CHECK(truth_trajectory.InterpolatePose(time, &true_pose));
+    CHECK(measured_trajectory.InterpolatePose(time, &measured_pose));
+    for (int k = 0; k < options.tie_points_per_exposure; ++k) {
+      Eigen::Vector3d X;
+      if (k % 2 == 0) {  // road surface ahead
+        X = centreline.Point(s0 + 6.0 + 14.0 * uniform(*rng),
+                             -4.0 + 8.0 * uniform(*rng));
+      } else {  // facade
+        const double side = uniform(*rng) < 0.5 ? -1.0 : 1.0;
+        X = centreline.Point(s0 + 10.0 + 20.0 * uniform(*rng), side * 8.0) +
+            Eigen::Vector3d(0, 0, 6.0 * uniform(*rng));
+      }
+      TieTrack track =
+          TieTrackOf(options, *survey, truth_trajectory, X, e, rng, normal);
+      if (track.observations.size() < 3) continue;
+      // As triangulated with the drifting trajectory.
+      track.p_enu =
+          measured_pose.T_enu_body() * (true_pose.T_enu_body().inverse() * X);
+      survey->tie_tracks.push_back(track);
+    }
+  }
+}
+
 }  // namespace
 
 SyntheticSurvey MakeSyntheticSurvey(const SyntheticSurveyOptions& options) {
@@ -160,111 +363,13 @@ SyntheticSurvey MakeSyntheticSurvey(const SyntheticSurveyOptions& options) {
   const double length = duration * options.speed_mps + 200.0;
   const Road road;
   const Centreline centreline(road, length);
-  const double imu_height = 1.0;
 
-  // True and measured samples.
-  Drift drift_e(options.drift_horizontal_m / std::sqrt(2.0),
-                options.drift_period_s, &rng);
-  Drift drift_n(options.drift_horizontal_m / std::sqrt(2.0),
-                options.drift_period_s, &rng);
-  Drift drift_u(options.drift_vertical_m, options.drift_period_s, &rng);
-  Drift drift_heading(options.heading_drift_deg * kDegToRad,
-                      options.drift_period_s, &rng);
-  Drift drift_roll(options.tilt_drift_deg * kDegToRad, options.drift_period_s,
-                   &rng);
-  Drift drift_pitch(options.tilt_drift_deg * kDegToRad, options.drift_period_s,
-                    &rng);
-  const int num_samples =
-      static_cast<int>(std::ceil(duration * options.trajectory_rate_hz)) + 1;
-  const Eigen::Vector3d sd_enu(0.03, 0.03, 0.05);
-  const Eigen::Vector3d sd_att(0.01 * kDegToRad, 0.01 * kDegToRad,
-                               0.03 * kDegToRad);
-  for (int i = 0; i < num_samples; ++i) {
-    const double t = i / options.trajectory_rate_hz;
-    const double s = 20.0 + options.speed_mps * t;
-    const double theta = road.Theta(s);
-    Attitude attitude;
-    attitude.heading = 0.5 * kPi - theta;
-    attitude.pitch = std::atan(road.Grade(s));
-    attitude.roll = 0.002 * std::sin(2.0 * kPi * 1.5 * t);
-    Pose truth;
-    truth.p_enu = centreline.Point(s, 0.0) + Eigen::Vector3d(0, 0, imu_height);
-    truth.q_enu_body = Eigen::Quaterniond(RotationEnuFromNed() *
-                                          RotationNedFromBody(attitude));
-    survey.truth_samples.push_back(
-        SampleFromPose(t0 + t, truth, survey.frame, sd_enu, sd_att));
-    Pose measured;
-    measured.p_enu =
-        truth.p_enu + Eigen::Vector3d(drift_e(t), drift_n(t), drift_u(t));
-    // Attitude error in the body frame: R_meas = R_true * Exp(error).
-    const Eigen::Vector3d error(drift_roll(t), drift_pitch(t),
-                                drift_heading(t));
-    const double angle = error.norm();
-    const Eigen::Quaterniond dq =
-        angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, error / angle))
-                  : Eigen::Quaterniond::Identity();
-    measured.q_enu_body = (truth.q_enu_body * dq).normalized();
-    survey.measured_samples.push_back(
-        SampleFromPose(t0 + t, measured, survey.frame, sd_enu, sd_att));
-  }
+  const TrajectoryDrift drift = DrawTrajectoryDrift(options, &rng);
+  AddTrajectorySamples(options, road, centreline, drift, t0, duration, &survey);
   const Trajectory truth_trajectory(survey.truth_samples, survey.frame);
-
-  // Crossings: bands across the road, long sides along it, corners
-  // counter-clockwise seen from above.
   const double s_end = 20.0 + options.speed_mps * duration;
-  int num_crossings = 0;
-  for (double s = 60.0; s < s_end; s += options.crossing_spacing_m) {
-    const int crossing = num_crossings++;
-    const Eigen::Vector3d offset(options.database_offset_m * normal(rng),
-                                 options.database_offset_m * normal(rng),
-                                 options.database_offset_m * normal(rng));
-    for (int b = 0; b < options.bands_per_crossing; ++b) {
-      const double l = (b - 0.5 * (options.bands_per_crossing - 1)) * 1.0;
-      const std::array<Eigen::Vector3d, 4> corners = {
-          centreline.Point(s - 1.5, l - 0.25),
-          centreline.Point(s + 1.5, l - 0.25),
-          centreline.Point(s + 1.5, l + 0.25),
-          centreline.Point(s - 1.5, l + 0.25)};
-      RoadmarkBand truth_band, db_band;
-      truth_band.crossing_id = db_band.crossing_id =
-          "X" + std::to_string(crossing + 1);
-      truth_band.band = db_band.band = b + 1;
-      truth_band.sigma_xy_m = db_band.sigma_xy_m = options.database_sigma_xy_m;
-      truth_band.sigma_z_m = db_band.sigma_z_m = options.database_sigma_z_m;
-      for (int v = 0; v < 4; ++v) {
-        truth_band.corners[v] = survey.frame.GeodeticFromEnu(corners[v]);
-        const Eigen::Vector3d noisy =
-            corners[v] + offset +
-            Eigen::Vector3d(options.database_sigma_xy_m * normal(rng),
-                            options.database_sigma_xy_m * normal(rng),
-                            options.database_sigma_z_m * normal(rng));
-        db_band.corners[v] = survey.frame.GeodeticFromEnu(noisy);
-      }
-      survey.truth_database.bands.push_back(truth_band);
-      survey.database.bands.push_back(db_band);
-    }
-  }
-
-  // Exposures.
-  for (int e = 0; e < options.num_exposures; ++e) {
-    const double time = t0 + margin_s + e * options.exposure_interval_s;
-    const int64_t exposure_id = 1000 + 7 * e;
-    Exposure exposure;
-    exposure.exposure_id = exposure_id;
-    exposure.time = time;
-    for (int c = 0; c < 2; ++c) {
-      ExposureImage image;
-      image.exposure_id = exposure_id;
-      image.time = time;
-      image.camera = c;
-      image.image = std::string("images/") + (c == 0 ? "left" : "right") + "/" +
-                    std::to_string(exposure_id) + ".png";
-      exposure.image_of_camera.push_back(
-          static_cast<int>(survey.exposures.images.size()));
-      survey.exposures.images.push_back(image);
-    }
-    survey.exposures.exposures.push_back(exposure);
-  }
+  AddCrossings(options, centreline, s_end, &rng, &normal, &survey);
+  survey.exposures = ExposuresOf(options, t0 + margin_s);
   IdealObservationOptions observe;
   observe.seed = options.seed + 1000;
   observe.pixel_noise_px = options.pixel_noise_px;
@@ -273,56 +378,8 @@ SyntheticSurvey MakeSyntheticSurvey(const SyntheticSurveyOptions& options) {
   MakeIdealObservations(observe, survey.rig, survey.frame, truth_trajectory,
                         survey.exposures, survey.truth_database,
                         survey.database, &survey.vertices, &survey.matches);
-  // Ideal tie points.
-  const Trajectory measured_trajectory(survey.measured_samples, survey.frame);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  for (int e = 0;
-       e < options.num_exposures && options.tie_points_per_exposure > 0; ++e) {
-    const double time = survey.exposures.exposures[e].time;
-    const double s0 = 20.0 + options.speed_mps * (time - t0);
-    Pose true_pose, measured_pose;
-    CHECK(truth_trajectory.InterpolatePose(time, &true_pose));
-    CHECK(measured_trajectory.InterpolatePose(time, &measured_pose));
-    for (int k = 0; k < options.tie_points_per_exposure; ++k) {
-      Eigen::Vector3d X;
-      if (k % 2 == 0) {  // road surface ahead
-        X = centreline.Point(s0 + 6.0 + 14.0 * uniform(rng),
-                             -4.0 + 8.0 * uniform(rng));
-      } else {  // facade
-        const double side = uniform(rng) < 0.5 ? -1.0 : 1.0;
-        X = centreline.Point(s0 + 10.0 + 20.0 * uniform(rng), side * 8.0) +
-            Eigen::Vector3d(0, 0, 6.0 * uniform(rng));
-      }
-      TieTrack track;
-      for (int f = e;
-           f < std::min(options.num_exposures, e + options.tie_track_exposures);
-           ++f) {
-        const Exposure& exposure = survey.exposures.exposures[f];
-        Pose pose;
-        CHECK(truth_trajectory.InterpolatePose(exposure.time, &pose));
-        for (int c = 0; c < 2; ++c) {
-          const RigCamera& camera = survey.rig.cameras[c];
-          const Eigen::Vector3d p_cam =
-              (pose.T_enu_body() * camera.T_body_cam).inverse() * X;
-          Eigen::Vector2d uv;
-          if (p_cam.z() < 2.0 || p_cam.norm() > 40.0 ||
-              !camera.camera.Project(p_cam, &uv) ||
-              !camera.camera.IsInImage(uv, 5.0)) {
-            continue;
-          }
-          uv +=
-              options.tie_noise_px * Eigen::Vector2d(normal(rng), normal(rng));
-          track.observations.push_back(
-              {exposure.image_of_camera[c], exposure.time, c, uv});
-        }
-      }
-      if (track.observations.size() < 3) continue;
-      // As triangulated with the drifting trajectory.
-      track.p_enu =
-          measured_pose.T_enu_body() * (true_pose.T_enu_body().inverse() * X);
-      survey.tie_tracks.push_back(track);
-    }
-  }
+  AddTiePoints(options, centreline, truth_trajectory, t0, &rng, &normal,
+               &survey);
   return survey;
 }
 
