@@ -245,32 +245,6 @@ std::string ReadWholeFile(const std::string& path,
   return text.str();
 }
 
-// A camera name as a YAML scalar: plain when it cannot be read as anything
-// but a string, double-quoted otherwise ("yes", "1", "a: b").
-std::string YamlName(const std::string& text) {
-  bool plain =
-      !text.empty() && std::isalpha(static_cast<unsigned char>(text.front()));
-  for (char c : text) {
-    plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
-                      c == '-' || c == '.');
-  }
-  std::string lower;
-  for (char c : text) {
-    lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  for (const char* keyword :
-       {"y", "n", "yes", "no", "true", "false", "on", "off", "null"}) {
-    plain = plain && lower != keyword;
-  }
-  if (plain) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') quoted += '\\';
-    quoted += c;
-  }
-  return quoted + "\"";
-}
-
 // "[a, b, c]"; `group` > 0 puts two spaces between groups (matrix rows).
 std::string NumberList(const double* values, int count, int group = 0) {
   std::string list = "[";
@@ -390,7 +364,7 @@ void WriteRig(const Rig& rig, const std::string& path) {
     for (int r = 0; r < 4; ++r) {
       for (int c = 0; c < 4; ++c) t[4 * r + c] = rig_camera.T_body_cam(r, c);
     }
-    out << "  - name: " << YamlName(camera.name()) << "\n"
+    out << "  - name: " << YamlScalar(camera.name()) << "\n"
         << "    width: " << camera.width() << "\n"
         << "    height: " << camera.height() << "\n"
         << "    K: " << NumberList(k, 9, 3) << "\n"
@@ -399,8 +373,8 @@ void WriteRig(const Rig& rig, const std::string& path) {
   }
   out << "stereo_pairs:" << (rig.stereo_pairs.empty() ? " []" : "") << "\n";
   for (const std::array<int, 2>& pair : rig.stereo_pairs) {
-    out << "  - [" << YamlName(rig.cameras.at(pair[0]).camera.name()) << ", "
-        << YamlName(rig.cameras.at(pair[1]).camera.name()) << "]\n";
+    out << "  - [" << YamlScalar(rig.cameras.at(pair[0]).camera.name()) << ", "
+        << YamlScalar(rig.cameras.at(pair[1]).camera.name()) << "]\n";
   }
   file.Commit();
 }

@@ -174,32 +174,6 @@ Geodetic ParseOrigin(const YAML::Node& node) {
   return Geodetic{values[0], values[1], values[2]};
 }
 
-// A file name as a YAML scalar: plain when it can only be read as a string
-// ("rig.yaml", "data/exposures.csv"), double-quoted otherwise.
-std::string YamlString(const std::string& text) {
-  bool plain =
-      !text.empty() && std::isalpha(static_cast<unsigned char>(text.front()));
-  for (char c : text) {
-    plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
-                      c == '-' || c == '.' || c == '/');
-  }
-  std::string lower;
-  for (char c : text) {
-    lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  }
-  for (const char* keyword :
-       {"y", "n", "yes", "no", "true", "false", "on", "off", "null"}) {
-    plain = plain && lower != keyword;
-  }
-  if (plain) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') quoted += '\\';
-    quoted += c;
-  }
-  return quoted + "\"";
-}
-
 }  // namespace
 
 SurveyManifest ReadManifest(const std::string& survey_folder,
@@ -275,11 +249,11 @@ SurveyManifest ReadManifest(const std::string& survey_folder,
 void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
   AtomicFile file(path);
   std::ostream& out = file.stream();
-  out << "name: " << YamlString(manifest.name) << "\n"
-      << "rig: " << YamlString(manifest.rig) << "\n"
-      << "trajectory: " << YamlString(manifest.trajectory) << "\n"
-      << "exposures: " << YamlString(manifest.exposures) << "\n"
-      << "roadmarks: " << YamlString(manifest.roadmarks) << "\n";
+  out << "name: " << YamlScalar(manifest.name, "/") << "\n"
+      << "rig: " << YamlScalar(manifest.rig, "/") << "\n"
+      << "trajectory: " << YamlScalar(manifest.trajectory, "/") << "\n"
+      << "exposures: " << YamlScalar(manifest.exposures, "/") << "\n"
+      << "roadmarks: " << YamlScalar(manifest.roadmarks, "/") << "\n";
   if (manifest.origin.has_value()) {
     const Geodetic& o = *manifest.origin;
     if (!std::isfinite(o.lat_deg) || !std::isfinite(o.lon_deg) ||
@@ -296,11 +270,12 @@ void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
       {"output_crs", &manifest.output_crs}};
   for (const auto& [key, crs] : crs_keys) {
     if (crs->is_set()) {
-      out << key << ": " << YamlString(crs->definition) << "\n";
+      out << key << ": " << YamlScalar(crs->definition, "/") << "\n";
     }
   }
   if (!manifest.roadmarks_layer.empty()) {
-    out << "roadmarks_layer: " << YamlString(manifest.roadmarks_layer) << "\n";
+    out << "roadmarks_layer: " << YamlScalar(manifest.roadmarks_layer, "/")
+        << "\n";
   }
   const RoadmarkFields& f = manifest.roadmarks_fields;
   const std::pair<const char*, const std::string*> fields[] = {
@@ -314,7 +289,7 @@ void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
     if (name->empty()) continue;
     if (!fields_header) out << "roadmarks_fields:\n";
     fields_header = true;
-    out << "  " << key << ": " << YamlString(*name) << "\n";
+    out << "  " << key << ": " << YamlScalar(*name, "/") << "\n";
   }
   if (manifest.roadmarks_margin_m != SurveyManifest().roadmarks_margin_m) {
     out << "roadmarks_margin_m: " << FormatDouble(manifest.roadmarks_margin_m)
@@ -323,7 +298,7 @@ void WriteManifest(const SurveyManifest& manifest, const std::string& path) {
   if (!manifest.crs_grid_dirs.empty()) {
     out << "crs_grid_dirs:\n";
     for (const std::string& folder : manifest.crs_grid_dirs) {
-      out << "  - " << YamlString(folder) << "\n";
+      out << "  - " << YamlScalar(folder, "/") << "\n";
     }
   }
   file.Commit();

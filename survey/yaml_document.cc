@@ -1,6 +1,8 @@
 #include "survey/yaml_document.h"
 
+#include <cctype>
 #include <map>
+#include <string>
 
 #include "survey/input_error.h"
 
@@ -51,6 +53,32 @@ YAML::Node ParseYamlDocument(const std::string& text,
   }
   ThrowOnDuplicateKeys(root, display_name, max_key_depth);
   return root;
+}
+
+std::string YamlScalar(const std::string& text, const char* also_plain) {
+  const std::string extra = also_plain;
+  bool plain =
+      !text.empty() && std::isalpha(static_cast<unsigned char>(text.front()));
+  for (char c : text) {
+    plain =
+        plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+                  c == '-' || c == '.' || extra.find(c) != std::string::npos);
+  }
+  std::string lower;
+  for (char c : text) {
+    lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  for (const char* keyword :
+       {"y", "n", "yes", "no", "true", "false", "on", "off", "null"}) {
+    plain = plain && lower != keyword;
+  }
+  if (plain) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
 }
 
 }  // namespace zebrageo

@@ -1,5 +1,5 @@
 // Parsing the survey's YAML files (survey.yaml, rig.yaml) with line-aware
-// errors, shared by their readers.
+// errors, shared by their readers; quoting for their writers.
 #ifndef ZEBRAGEO_SURVEY_YAML_DOCUMENT_H_
 #define ZEBRAGEO_SURVEY_YAML_DOCUMENT_H_
 
@@ -22,6 +22,12 @@ int YamlLine(const YAML::Node& node);
 YAML::Node ParseYamlDocument(const std::string& text,
                              const std::string& display_name,
                              int max_key_depth = 3);
+
+// `text` as a YAML scalar for the writers: plain when it can only be read
+// as a string (a letter, then letters, digits, '_', '-', '.' or a character
+// of `also_plain`, and no YAML 1.1 boolean or null such as "yes" or "off"),
+// double-quoted otherwise ("1", "a: b").
+std::string YamlScalar(const std::string& text, const char* also_plain = "");
 
 }  // namespace zebrageo
 

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "survey/input_error.h"
+#include "survey/yaml_document.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -366,6 +369,36 @@ TEST(Manifest, WriteThenReadIsExact) {
   EXPECT_EQ(read.origin->lat_deg, manifest.origin->lat_deg);
   EXPECT_EQ(read.origin->lon_deg, manifest.origin->lon_deg);
   EXPECT_EQ(read.origin->h_m, manifest.origin->h_m);
+}
+
+// Names YAML would read as something else are quoted, and read back as
+// written: booleans, numbers, nulls, colons, quotes.
+TEST(Manifest, NamesYamlWouldMisreadRoundTrip) {
+  for (const char* name_text :
+       {"yes", "Off", "null", "1", "3.5", "a: b", "say \"hi\"", "back\\slash",
+        "data/roadmarks.geojson", "-x", ""}) {
+    const std::string name = name_text;
+    SCOPED_TRACE(name);
+    TemporaryFolder folder;
+    SurveyManifest manifest;
+    manifest.name = name;
+    manifest.roadmarks = "data/roadmarks.geojson";
+    WriteManifest(manifest, folder.Path("survey.yaml"));
+    std::ifstream in(folder.Path("survey.yaml"));
+    const std::string text((std::istreambuf_iterator<char>(in)),
+                           std::istreambuf_iterator<char>());
+    // File names with a '/' stay plain (readable by hand).
+    EXPECT_NE(text.find("roadmarks: data/roadmarks.geojson\n"),
+              std::string::npos);
+    if (name.empty()) continue;  // no survey has an empty name
+    // Python's YAML 1.1 reader (the shared checker's) would read these as
+    // booleans, null or numbers: quoted.
+    if (name == "yes" || name == "Off" || name == "null" || name == "1") {
+      EXPECT_NE(text.find("name: \"" + name + "\"\n"), std::string::npos);
+    }
+    const YAML::Node node = YAML::Load(text);
+    EXPECT_EQ(node["name"].as<std::string>(), name);
+  }
 }
 
 TEST(Manifest, WriteLeavesNoTemporaryAndFailsCleanly) {
