@@ -41,10 +41,12 @@ sanitizer_build() {  # sanitizer_build DIR TARGET CMAKE-ARGS...
 }
 
 # AddressSanitizer + UndefinedBehaviorSanitizer over every suite (ctest
-# labels sanitize and sanitize_threads). Left out (label no_sanitize, see
-# tests/CMakeLists.txt): the tests that drive the real binary through many or
-# large simulated surveys, 3-5x slower here (over 40 minutes on 2 cores);
-# report_test still runs one small survey through every stage of the binary.
+# labels sanitize and sanitize_threads). The suites that drive the real
+# binary or the simulator through whole surveys, 3-5x slower here (over 40
+# minutes on 2 cores whole), run only the cases of their ASAN_FILTER, each
+# suite in one process (zebrageo_test in tests/CMakeLists.txt); report_test
+# runs one small survey through every stage of the binary. Left out (label
+# no_sanitize): report_render, Chromium's rendering of report_test's output.
 sanitizer_build "$here/build-asan" zebrageo_sanitize_tests -DZEBRAGEO_SANITIZE=ON
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir "$here/build-asan" --output-on-failure -j "$jobs" \
