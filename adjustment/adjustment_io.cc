@@ -93,6 +93,8 @@ AdjustmentRecord RecordOf(const AdjustmentData& data,
   m.position_sigma_m = s.position_sigma_m;
   m.position_tau_s = s.position_tau_s;
   m.attitude_sigma_deg = RadToDeg(1.0) * s.attitude_sigma_rad;
+  m.attitude_significance = s.attitude_significance;
+  for (int a = 0; a < 3; ++a) m.attitude_held[a] = s.attitude_held[a] != 0;
   m.vehicle_motion_sigma_deg = Eigen::Vector2d(
       RadToDeg(s.motion_sigma_rad.x()), RadToDeg(s.motion_sigma_rad.y()));
   m.tie_sigma_px = s.tie_sigma_px;

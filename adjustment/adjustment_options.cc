@@ -113,6 +113,11 @@ std::string AdjustmentOptions::Check() const {
     return Violation("reject_crossing_share", reject_crossing_share,
                      "must be in (0, 1]");
   }
+  if (!(attitude_significance >= 0.0) ||
+      !std::isfinite(attitude_significance)) {
+    return Violation("attitude_significance", attitude_significance,
+                     "must be finite and >= 0 (0 disables)");
+  }
   if (max_knots_for_covariance < 0) {
     return Violation("max_knots_for_covariance", max_knots_for_covariance,
                      "must be >= 0");

@@ -1,5 +1,6 @@
 #include "adjustment/adjustment_problem.h"
 
+#include <ceres/manifold.h>
 #include <glog/logging.h>
 
 #include <Eigen/Cholesky>
@@ -170,6 +171,7 @@ void AdjustmentProblem::AddKnotPriors() {
   const double dt = state_->correction.knot_spacing();
   for (Knot& k : knots) problem_->AddParameterBlock(k.data(), kKnotSize);
   num_pose_blocks_ = n;
+  HoldAttitudeAxes();
   const Eigen::Matrix<double, 6, 1> sigma = state_->model.Sigma();
   const Eigen::Matrix<double, 6, 1> level = state_->model.LevelSigma();
   const Eigen::Matrix<double, 6, 1> tau = state_->model.Tau();
@@ -202,6 +204,24 @@ void AdjustmentProblem::AddKnotPriors() {
       (part == 0 ? blocks_.attitude_prior : blocks_.position_prior)
           .push_back(id);
     }
+  }
+}
+
+void AdjustmentProblem::HoldAttitudeAxes() {
+  // Held axes stay at the prior's centre: the input's attitude (with its
+  // jumps, knot_prior).
+  std::vector<int> held;
+  for (int a = 0; a < 3; ++a) {
+    if (state_->attitude_held[a]) held.push_back(a);
+  }
+  if (held.empty()) return;
+  auto& knots = state_->correction.knots();
+  for (size_t k = 0; k < knots.size(); ++k) {
+    for (int a : held) {
+      knots[k][a] = state_->knot_prior.empty() ? 0.0 : state_->knot_prior[k][a];
+    }
+    problem_->SetManifold(knots[k].data(),
+                          new ceres::SubsetManifold(kKnotSize, held));
   }
 }
 

@@ -53,6 +53,8 @@ class AdjustmentProblem {
                         double sigma_px,
                         std::vector<ceres::ResidualBlockId>* ids);
   void AddKnotPriors();
+  // The attitude axes of State::attitude_held fixed on every knot.
+  void HoldAttitudeAxes();
   void AddRigPriors();
   void AddControl();
   void AddTiesAndLines();

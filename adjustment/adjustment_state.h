@@ -140,6 +140,9 @@ struct State {
   // from the trajectory before the knot (track frame).
   std::vector<Eigen::Matrix<double, 6, 1>> knot_prior;
   ErrorModel model;
+  // Attitude components of the correction (0..2 of a knot) held at their
+  // prior centre, the input's attitude (attitude_significance.h).
+  std::array<bool, 3> attitude_held{};
 
   // Index of the exposure at `time` (to a microsecond), or -1.
   int ExposureIndex(double time) const;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "adjustment/attitude_significance.h"
 #include "adjustment/variance_components.h"
 #include "survey/math_util.h"
 
@@ -155,6 +156,14 @@ bool RunAdjustments(const Context& context, State* state,
     return false;
   }
   bool adjusted = solver->Adjust();
+  // The attitude axes the control does not determine held at the input's
+  // before anything is measured: the check points' held-out residuals
+  // come from the adjustment the user gets.
+  if (adjusted &&
+      HoldInsignificantAttitude(context, state, solver->problem())) {
+    ResetState(state);
+    adjusted = solver->Adjust();
+  }
   if (adjusted && any_check && options.check_points_in_final) {
     HoldOutCheckPoints(context, state);
     ResetState(state);

@@ -34,8 +34,10 @@
 // band period away from it is named as such. A share of crossings is held
 // out as check points: their residuals come from an adjustment without
 // them; the final adjustment then uses them as control
-// (check_points_in_final). Without any usable control the input trajectory
-// is returned unchanged.
+// (check_points_in_final). The attitude axes whose correction the control
+// does not determine (attitude_significance) are then held at the input's
+// and the adjustment solved again. Without any usable control the input
+// trajectory is returned unchanged.
 #ifndef ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 #define ZEBRAGEO_ADJUSTMENT_TRAJECTORY_ADJUSTER_H_
 
@@ -103,6 +105,16 @@ struct AdjustmentOptions {
   double min_attitude_sigma_rad = DegToRad(0.003);
   double max_attitude_sigma_rad = DegToRad(0.5);
   double attitude_tau_s = 60.0;
+  // Attitude significance: after the adjustment, each axis of the attitude
+  // correction (about along-track, cross-track, up) is kept only where it
+  // departs from the INS's attitude by at least this many of its posterior
+  // standard deviations at some knot. Below that the control does not
+  // determine the axis (a crossing seen from a few metres measures heading
+  // to about a tenth of a degree, the INS's to a few hundredths): the axis
+  // keeps the input attitude and the adjustment is solved again with it
+  // held. 0 keeps every axis (needs the posterior covariance:
+  // compute_covariance and max_knots_for_covariance).
+  double attitude_significance = 2.0;
   // Variance components: after a solve, each soft constraint (vehicle
   // motion, tie points, the attitude prior) is checked against the data and
   // its sigma widened where its residuals show more than it states; the
@@ -332,6 +344,11 @@ struct AdjustmentSummary {
   double vehicle_yaw_misalignment_deg = 0.0;
   double vehicle_pitch_misalignment_deg = 0.0;
   double vehicle_axle_offset_m = 0.0;
+  // Attitude axes (along-track, cross-track, up) held at the input's for
+  // lack of significance (attitude_significance), and each axis' largest
+  // correction over its posterior sd.
+  Eigen::Vector3i attitude_held = Eigen::Vector3i::Zero();
+  Eigen::Vector3d attitude_significance = Eigen::Vector3d::Zero();
   // Jumps found in the input trajectory (GNSS returns).
   int num_jumps = 0;
   // Posterior sd of the corrected positions (median over the samples, 0

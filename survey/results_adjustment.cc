@@ -101,6 +101,8 @@ json ModelJson(const AdjustmentRecord::Model& m) {
       {"position_sigma_m", Vector3Json(m.position_sigma_m)},
       {"position_tau_s", Vector3Json(m.position_tau_s)},
       {"attitude_sigma_deg", Vector3Json(m.attitude_sigma_deg)},
+      {"attitude_significance", Vector3Json(m.attitude_significance)},
+      {"attitude_held", m.attitude_held},
       {"vehicle_motion_sigma_deg",
        {m.vehicle_motion_sigma_deg.x(), m.vehicle_motion_sigma_deg.y()}},
       {"tie_sigma_px", m.tie_sigma_px},
@@ -153,6 +155,8 @@ AdjustmentRecord::Model ReadModel(const Fields& f) {
   m.position_sigma_m = f.Vector<3>("position_sigma_m");
   m.position_tau_s = f.Vector<3>("position_tau_s");
   m.attitude_sigma_deg = f.Vector<3>("attitude_sigma_deg");
+  m.attitude_significance = f.Vector<3>("attitude_significance");
+  m.attitude_held = f.Get<std::array<bool, 3>>("attitude_held");
   m.vehicle_motion_sigma_deg = f.Vector<2>("vehicle_motion_sigma_deg");
   m.tie_sigma_px = f.Number("tie_sigma_px");
   m.vertex_sigma_px = f.Number("vertex_sigma_px");

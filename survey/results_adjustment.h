@@ -9,6 +9,7 @@
 #define ZEBRAGEO_SURVEY_RESULTS_ADJUSTMENT_H_
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -91,6 +92,11 @@ struct AdjustmentRecord {
     Eigen::Vector3d position_sigma_m = Eigen::Vector3d::Zero();
     Eigen::Vector3d position_tau_s = Eigen::Vector3d::Zero();
     Eigen::Vector3d attitude_sigma_deg = Eigen::Vector3d::Zero();
+    // Per attitude axis: its largest correction over its posterior sd,
+    // and whether it was held at the input's for being below the
+    // adjustment's threshold (AdjustmentOptions::attitude_significance).
+    Eigen::Vector3d attitude_significance = Eigen::Vector3d::Zero();
+    std::array<bool, 3> attitude_held{};
     Eigen::Vector2d vehicle_motion_sigma_deg = Eigen::Vector2d::Zero();
     double tie_sigma_px = 0.0;
     double vertex_sigma_px = 0.0;

@@ -251,10 +251,15 @@ TEST(TrajectoryAdjuster, VehicleMotionHoldsTheHeadingBetweenCrossings) {
   survey_options.crossing_spacing_m = 120.0;
   survey_options.heading_drift_deg = 0.15;
   const Fixture f = MakeFixture(survey_options);
-  AdjustmentOptions without;
+  // The constraint's effect on the heading itself: the significance test
+  // (attitude_significance_test.cc) holds this heading correction, at 1.7
+  // posterior sd, at the input's.
+  AdjustmentOptions with;
+  with.attitude_significance = 0.0;
+  AdjustmentOptions without = with;
   without.sideslip_sigma_rad = 0.0;
   const AdjustmentResult a = AdjustTrajectory(without, f.Input());
-  const AdjustmentResult b = AdjustTrajectory(AdjustmentOptions(), f.Input());
+  const AdjustmentResult b = AdjustTrajectory(with, f.Input());
   ASSERT_TRUE(a.summary.IsUsable()) << a.summary.message;
   ASSERT_TRUE(b.summary.IsUsable()) << b.summary.message;
   EXPECT_EQ(a.summary.num_vehicle_motion, 0);
@@ -315,7 +320,9 @@ TEST(TrajectoryAdjuster, TenHertzBodyOscillationIsNotAJump) {
   const PoseErrors before = ScorePoses(f.survey, InputCameraPoses(f.survey));
   const PoseErrors after = ScorePoses(f.survey, result.camera_poses);
   EXPECT_LT(after.rmse_horizontal_m, 0.08);
-  EXPECT_LT(after.rmse_attitude_deg, before.rmse_attitude_deg);
+  // Its heading correction is not significant (attitude_significance): the
+  // attitude may stay the input's, never worse.
+  EXPECT_LE(after.rmse_attitude_deg, before.rmse_attitude_deg + 1e-6);
 }
 
 // GNSS coming back after an outage: the solution steps by 0.2 m between two

@@ -58,6 +58,8 @@ AdjustmentRecord SampleRecord() {
   r.rig.push_back({"left", Eigen::Vector3d(1.5, 0.3, -1.9), 0.0});
   r.model.knot_spacing_s = 1.0;
   r.model.attitude_sigma_deg = Eigen::Vector3d(0.01, 0.01, 0.05);
+  r.model.attitude_significance = Eigen::Vector3d(0.3, 0.5, 2.5);
+  r.model.attitude_held = {true, true, false};
   r.model.vehicle_motion_sigma_deg = Eigen::Vector2d(0.5, 0.25);
   r.tie_points = AdjustmentRecord::TiePoints{240, 0, 5000, 900, 3600, 4.25};
   r.warnings = {"2 of 240 images are missing: no tie points in them"};

