@@ -51,9 +51,13 @@ struct TiePointOptions {
   int min_track_length = 4;
   // Keep only tracks seen by both cameras of a stereo pair at least once.
   bool require_stereo = true;
-  // Tracks kept per exposure (the longest first): enough to tie, few
-  // enough to keep the adjustment fast.
-  int max_tracks_per_exposure = 25;
+  // Tracks kept per exposure (the longest first), to bound the
+  // adjustment's size. Where the GNSS/INS jitters from one exposure to the
+  // next, the tracks are what carries the along-track position between
+  // crossings: buenos-aires (field case) H 5.5 cm with 25, 4.3 cm with
+  // 100 (150 tracks in place of 132); the urban preset keeps 1794 tracks in
+  // place of 1711, its adjustment ~20% longer.
+  int max_tracks_per_exposure = 100;
 
   // "" when valid, else "field = value: constraint".
   std::string Check() const;
