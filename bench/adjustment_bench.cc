@@ -320,15 +320,7 @@ int Main(int argc, char** argv) {
     survey_options.tie_points_per_exposure = ties;
     const SyntheticSurvey survey = MakeSyntheticSurvey(survey_options);
     const Trajectory trajectory(survey.measured_samples, survey.frame);
-    AdjustmentInput input;
-    input.rig = &survey.rig;
-    input.frame = &survey.frame;
-    input.trajectory = &trajectory;
-    input.exposures = &survey.exposures;
-    input.roadmarks = &survey.database;
-    input.vertices = &survey.vertices;
-    input.matches = &survey.matches;
-    if (!survey.tie_tracks.empty()) input.tie_tracks = &survey.tie_tracks;
+    const AdjustmentInput input = SyntheticAdjustmentInput(survey, trajectory);
     AdjustmentOptions options;
     options.solver.num_threads = threads;
     options.compute_covariance = false;

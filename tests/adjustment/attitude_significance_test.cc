@@ -21,16 +21,7 @@ struct Fixture {
       : survey(MakeSyntheticSurvey(options)),
         trajectory(survey.measured_samples, survey.frame) {}
   AdjustmentInput Input() const {
-    AdjustmentInput input;
-    input.rig = &survey.rig;
-    input.frame = &survey.frame;
-    input.trajectory = &trajectory;
-    input.exposures = &survey.exposures;
-    input.roadmarks = &survey.database;
-    input.vertices = &survey.vertices;
-    input.matches = &survey.matches;
-    if (!survey.tie_tracks.empty()) input.tie_tracks = &survey.tie_tracks;
-    return input;
+    return SyntheticAdjustmentInput(survey, trajectory);
   }
 };
 

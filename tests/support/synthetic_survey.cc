@@ -541,4 +541,18 @@ void WriteSyntheticSurvey(const SyntheticSurvey& survey,
                results_folder + "/" + kMatchesFile);
 }
 
+AdjustmentInput SyntheticAdjustmentInput(const SyntheticSurvey& survey,
+                                         const Trajectory& trajectory) {
+  AdjustmentInput input;
+  input.rig = &survey.rig;
+  input.frame = &survey.frame;
+  input.trajectory = &trajectory;
+  input.exposures = &survey.exposures;
+  input.roadmarks = &survey.database;
+  input.vertices = &survey.vertices;
+  input.matches = &survey.matches;
+  if (!survey.tie_tracks.empty()) input.tie_tracks = &survey.tie_tracks;
+  return input;
+}
+
 }  // namespace zebrageo

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "adjustment/trajectory_adjuster.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/results.h"
@@ -79,6 +80,11 @@ struct SyntheticSurvey {
 };
 
 SyntheticSurvey MakeSyntheticSurvey(const SyntheticSurveyOptions& options);
+
+// The adjustment's input on `survey` with `trajectory` (its measured
+// samples; both outlive the input), with its tie tracks when it has any.
+AdjustmentInput SyntheticAdjustmentInput(const SyntheticSurvey& survey,
+                                         const Trajectory& trajectory);
 
 // Writes the survey folder (survey.yaml, rig.yaml, trajectory.csv,
 // exposures.csv, roadmarks.geojson, truth/trajectory.csv,
