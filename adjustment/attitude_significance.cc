@@ -55,20 +55,21 @@ bool HoldInsignificantAttitude(const Context& context, State* state,
                                AdjustmentProblem* problem) {
   const double threshold = context.options.attitude_significance;
   if (threshold <= 0.0) return false;
-  Eigen::Vector3d significance;
-  if (!AttitudeSignificance(context, *state, problem, &significance)) {
-    return false;
-  }
   // One crossing, seen on one approach, measures the heading only together
   // with the rate of the cross-track drift (both turn its bands the same
   // way as the vehicle nears it), and the tilt with the vertical drift's:
   // the split is the priors', not the data's. Two crossings apart measure
-  // the drift between them.
+  // the drift between them. So with one, every axis is held (significance
+  // 0, not computed).
   std::set<int> crossings;
   for (const ControlPoint& p : state->points) {
     if (p.status == ControlStatus::kControl) crossings.insert(p.crossing);
   }
-  if (crossings.size() < 2) significance.setZero();
+  Eigen::Vector3d significance = Eigen::Vector3d::Zero();
+  if (crossings.size() >= 2 &&
+      !AttitudeSignificance(context, *state, problem, &significance)) {
+    return false;
+  }
   context.summary->attitude_significance = significance;
   static const char* const kAxes[3] = {"along-track", "cross-track", "up"};
   std::ostringstream held;

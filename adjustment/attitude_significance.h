@@ -28,9 +28,10 @@ bool AttitudeSignificance(const Context& context, const State& state,
                           AdjustmentProblem* problem,
                           Eigen::Vector3d* significance);
 
-// Holds the axes below attitude_significance (State::attitude_held, logged
-// and in the summary) and returns whether any was newly held: the caller
-// solves again.
+// Holds the axes below attitude_significance, and every axis with fewer
+// than two control crossings (their covariance is then not computed):
+// State::attitude_held, logged and in the summary. Returns whether any was
+// newly held: the caller solves again.
 bool HoldInsignificantAttitude(const Context& context, State* state,
                                AdjustmentProblem* problem);
 
