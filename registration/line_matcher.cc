@@ -1,100 +1,26 @@
 #include "registration/line_matcher.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <unordered_map>
 #include <utility>
 
+#include "registration/line_geometry_internal.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
-namespace {
 
-bool Compatible(const std::string& a, const std::string& b) {
-  const bool stop_a = a == "stop_line", stop_b = b == "stop_line";
-  const bool lane_a = a.rfind("lane_", 0) == 0,
-             lane_b = b.rfind("lane_", 0) == 0;
-  return (stop_a && stop_b) || (lane_a && lane_b);
-}
-
-// Nearest point (horizontally) of segment ab to p; t in [0, 1].
-double SegmentDistance2d(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                         const Eigen::Vector3d& b, double* t) {
-  const Eigen::Vector2d d = (b - a).head<2>();
-  const double l2 = d.squaredNorm();
-  *t = l2 > 0.0 ? std::clamp((p - a).head<2>().dot(d) / l2, 0.0, 1.0) : 0.0;
-  return (p.head<2>() - (a.head<2>() + *t * d)).norm();
-}
-
-struct Nearest {
-  int line = -1;
-  int segment = -1;
-  double t = 0.0;
-  double distance = std::numeric_limits<double>::infinity();
-};
-
-// The database's segments in a uniform grid, so that a point meets only
-// the segments near it (a city's database holds tens of thousands of lines).
-class SegmentGrid {
- public:
-  SegmentGrid(const std::vector<DatabaseLineEnu>& database, double cell_m)
-      : cell_m_(cell_m) {
-    for (int l = 0; l < static_cast<int>(database.size()); ++l) {
-      const auto& points = database[l].points;
-      for (int s = 0; s + 1 < static_cast<int>(points.size()); ++s) {
-        const Eigen::Vector2d a = points[s].head<2>();
-        const Eigen::Vector2d b = points[s + 1].head<2>();
-        const auto [x0, y0] = Cell(a.cwiseMin(b));
-        const auto [x1, y1] = Cell(a.cwiseMax(b));
-        for (int64_t x = x0; x <= x1; ++x) {
-          for (int64_t y = y0; y <= y1; ++y)
-            cells_[Key(x, y)].push_back({l, s});
-        }
-      }
-    }
-  }
-
-  // Every segment with a part within `radius` of p (and a few more), each
-  // once, grouped by line in `out`.
-  void Near(const Eigen::Vector2d& p, double radius,
-            std::map<int, std::vector<int>>* out) const {
-    out->clear();
-    const Eigen::Vector2d r(radius, radius);
-    const auto [x0, y0] = Cell(p - r);
-    const auto [x1, y1] = Cell(p + r);
-    for (int64_t x = x0; x <= x1; ++x) {
-      for (int64_t y = y0; y <= y1; ++y) {
-        const auto it = cells_.find(Key(x, y));
-        if (it == cells_.end()) continue;
-        for (const auto& [line, segment] : it->second) {
-          (*out)[line].push_back(segment);
-        }
-      }
-    }
-    for (auto& [line, segments] : *out) {
-      std::sort(segments.begin(), segments.end());
-      segments.erase(std::unique(segments.begin(), segments.end()),
-                     segments.end());
-    }
-  }
-
- private:
-  std::pair<int64_t, int64_t> Cell(const Eigen::Vector2d& p) const {
-    return {static_cast<int64_t>(std::floor(p.x() / cell_m_)),
-            static_cast<int64_t>(std::floor(p.y() / cell_m_))};
-  }
-  static uint64_t Key(int64_t x, int64_t y) {
-    return (static_cast<uint64_t>(x) << 32) ^
-           (static_cast<uint64_t>(y) & 0xffffffffULL);
-  }
-  double cell_m_;
-  std::unordered_map<uint64_t, std::vector<std::pair<int, int>>> cells_;
-};
-
-}  // namespace
+using line_geometry_internal::Compatible;
+using line_geometry_internal::Nearest;
+using line_geometry_internal::SegmentDistance2d;
+using line_geometry_internal::SegmentGrid;
 
 std::string LineMatchOptions::Check() const {
   std::ostringstream e;
@@ -262,12 +188,14 @@ std::string LineConsistencyOptions::Check() const {
 namespace {
 
 // The matches of one database line within one second: their median
-// distance across the line, the line's normal there, and how many.
+// distance across the line, the line's normal there, where the database
+// line is (the mean of the matched points), and how many.
 struct LineSecond {
   int db_line = 0;
   int64_t second = 0;
   double distance_m = 0.0;
   Eigen::Vector2d across = Eigen::Vector2d::Zero();
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
   int points = 0;
 };
 
@@ -283,16 +211,127 @@ std::vector<LineSecond> LineSeconds(const std::vector<LinePointMatch>& matches,
   std::vector<double> distances;
   for (const auto& [key, members] : groups) {
     distances.clear();
-    for (int i : members) distances.push_back(matches[i].distance_m);
     LineSecond s;
+    for (int i : members) {
+      distances.push_back(matches[i].distance_m);
+      s.position += matches[i].db_point_enu.head<2>();
+    }
     s.db_line = key.first;
     s.second = key.second;
     s.distance_m = Median(distances);
     s.across = matches[members.front()].across_enu.head<2>();
+    s.position /= static_cast<double>(members.size());
     s.points = static_cast<int>(members.size());
     seconds.push_back(s);
   }
+  std::stable_sort(seconds.begin(), seconds.end(),
+                   [](const LineSecond& a, const LineSecond& b) {
+                     return a.second < b.second;
+                   });
   return seconds;
+}
+
+// Database lines closer than this across each other are one painted line
+// (the dashes of a lane divider, a solid line drawn in pieces): they share
+// a repaint, so one cannot vouch for another, and they are tested and
+// rejected together; the lines within one metre across vote once, or a
+// dashed line of many pieces would outvote the solid lines beside it.
+constexpr double kSameLineM = 0.5;
+constexpr double kVoteBinM = 1.0;
+// Offsets this close to the worst are tied with it.
+constexpr double kTiedOffsetM = 0.02;
+
+// The median, the mean of the middle two of an even count: two other lines
+// that disagree put the reference half way, blaming neither.
+double MiddleOf(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t half = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + half, values.end());
+  if (values.size() % 2 == 1) return values[half];
+  const double upper = values[half];
+  return 0.5 *
+         (upper + *std::max_element(values.begin(), values.begin() + half));
+}
+
+// The painted line of each database line in `seconds` (the smallest
+// database line index of its group): lines parallel and within kSameLineM
+// across each other, seen within window_s.
+std::map<int, int> PaintedLines(const std::vector<LineSecond>& seconds,
+                                const LineConsistencyOptions& options) {
+  std::map<int, int> parent;
+  for (const LineSecond& s : seconds) parent[s.db_line] = s.db_line;
+  const std::function<int(int)> root = [&](int l) {
+    while (parent[l] != l) l = parent[l] = parent[parent[l]];
+    return l;
+  };
+  const int64_t window = static_cast<int64_t>(std::ceil(options.window_s));
+  for (size_t i = 0; i < seconds.size(); ++i) {
+    for (size_t j = i + 1;
+         j < seconds.size() && seconds[j].second <= seconds[i].second + window;
+         ++j) {
+      const LineSecond& a = seconds[i];
+      const LineSecond& b = seconds[j];
+      const double cos = a.across.dot(b.across);
+      if (std::abs(cos) < options.min_parallel_cos) continue;
+      // Across both normals (one short dash's direction is a degree or two
+      // off): the same however the two are ordered.
+      const Eigen::Vector2d normal =
+          (a.across + (cos < 0.0 ? -b.across : b.across)).normalized();
+      if (std::abs(normal.dot(b.position - a.position)) >= kSameLineM) {
+        continue;
+      }
+      const int ra = root(a.db_line);
+      const int rb = root(b.db_line);
+      parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  }
+  std::map<int, int> painted;
+  for (const auto& [line, unused] : parent) painted[line] = root(line);
+  return painted;
+}
+
+// Per painted line not in `excluded`: the median of its offsets from the
+// other painted lines' displacements in the same window, and its points.
+std::map<int, std::pair<double, int>> LineOffsets(
+    const std::vector<LineSecond>& seconds, const std::map<int, int>& painted,
+    const std::set<int>& excluded, const LineConsistencyOptions& options) {
+  const int64_t window = static_cast<int64_t>(std::ceil(options.window_s));
+  std::map<int, std::vector<double>> offsets_of_line;
+  std::map<int, int> points_of_line;
+  std::map<int64_t, std::vector<double>> other_lines;
+  std::vector<double> references;
+  for (const LineSecond& s : seconds) {
+    const int line = painted.at(s.db_line);
+    if (excluded.count(line)) continue;
+    other_lines.clear();
+    const auto first = std::lower_bound(
+        seconds.begin(), seconds.end(), s.second - window,
+        [](const LineSecond& a, int64_t t) { return a.second < t; });
+    for (auto o = first; o != seconds.end() && o->second <= s.second + window;
+         ++o) {
+      const int other = painted.at(o->db_line);
+      if (other == line || excluded.count(other)) continue;
+      const double cos = o->across.dot(s.across);
+      if (std::abs(cos) < options.min_parallel_cos) continue;
+      const double lateral = s.across.dot(o->position - s.position);
+      if (std::abs(lateral) < kSameLineM) continue;
+      // The other line's displacement, along this line's normal.
+      other_lines[std::llround(lateral / kVoteBinM)].push_back(o->distance_m *
+                                                               cos);
+    }
+    if (other_lines.empty()) continue;
+    references.clear();
+    for (const auto& [bin, values] : other_lines) {
+      references.push_back(Median(values));
+    }
+    offsets_of_line[line].push_back(s.distance_m - MiddleOf(references));
+    points_of_line[line] += s.points;
+  }
+  std::map<int, std::pair<double, int>> out;
+  for (const auto& [line, offsets] : offsets_of_line) {
+    out[line] = {Median(offsets), points_of_line[line]};
+  }
+  return out;
 }
 
 }  // namespace
@@ -300,59 +339,71 @@ std::vector<LineSecond> LineSeconds(const std::vector<LinePointMatch>& matches,
 std::vector<RejectedLine> RejectInconsistentLines(
     const std::vector<LinePointMatch>& matches,
     const std::vector<double>& point_time,
-    const LineConsistencyOptions& options, std::vector<LinePointMatch>* kept) {
+    const LineConsistencyOptions& options, std::vector<LinePointMatch>* kept,
+    std::set<int>* checked) {
   // Per line and second first, so that each other line counts once in a
   // reference however many points it has (a long solid line would
   // otherwise outvote every dash of the centre line).
-  std::vector<LineSecond> seconds = LineSeconds(matches, point_time);
-  std::stable_sort(seconds.begin(), seconds.end(),
-                   [](const LineSecond& a, const LineSecond& b) {
-                     return a.second < b.second;
-                   });
-  const int64_t window = static_cast<int64_t>(std::ceil(options.window_s));
-  std::map<int, std::vector<double>> offsets_of_line;
-  std::map<int, int> points_of_line;
-  std::map<int, std::vector<double>> other_lines;
-  std::vector<double> references;
-  for (const LineSecond& s : seconds) {
-    other_lines.clear();
-    const auto first = std::lower_bound(
-        seconds.begin(), seconds.end(), s.second - window,
-        [](const LineSecond& a, int64_t t) { return a.second < t; });
-    for (auto o = first; o != seconds.end() && o->second <= s.second + window;
-         ++o) {
-      if (o->db_line == s.db_line) continue;
-      const double cos = o->across.dot(s.across);
-      if (std::abs(cos) < options.min_parallel_cos) continue;
-      // The other line's displacement, along this line's normal.
-      other_lines[o->db_line].push_back(o->distance_m * cos);
+  const std::vector<LineSecond> seconds = LineSeconds(matches, point_time);
+  const std::map<int, int> painted = PaintedLines(seconds, options);
+  // The worst painted line first, then the test again without it: one
+  // repainted line must not make the lines beside it look offset.
+  std::vector<std::pair<int, double>> worst_lines;  // painted line, offset
+  std::set<int> excluded;
+  std::set<int> checked_painted;
+  for (;;) {
+    const std::map<int, std::pair<double, int>> offsets =
+        LineOffsets(seconds, painted, excluded, options);
+    double worst = 0.0;
+    checked_painted.clear();
+    for (const auto& [line, offset] : offsets) {
+      VLOG(2) << "painted line " << line << ": offset " << offset.first
+              << " m over " << offset.second << " points";
+      if (offset.second < options.min_points) continue;
+      checked_painted.insert(line);
+      if (std::abs(offset.first) > options.max_offset_m) {
+        worst = std::max(worst, std::abs(offset.first));
+      }
     }
-    if (other_lines.empty()) continue;
-    references.clear();
-    for (const auto& [line, values] : other_lines) {
-      references.push_back(Median(values));
+    if (worst == 0.0) break;
+    // Lines as far off as the worst (two lines that disagree, each the
+    // other's reference) go together: which one is wrong is not known, and
+    // the order of the database must not decide it.
+    for (const auto& [line, offset] : offsets) {
+      if (checked_painted.count(line) &&
+          std::abs(offset.first) > options.max_offset_m &&
+          std::abs(offset.first) >= worst - kTiedOffsetM) {
+        worst_lines.push_back({line, offset.first});
+        excluded.insert(line);
+      }
     }
-    offsets_of_line[s.db_line].push_back(s.distance_m - Median(references));
-    points_of_line[s.db_line] += s.points;
   }
+  // Every database line of a rejected painted line, with its points.
+  std::map<int, int> points_of;
+  for (const LineSecond& s : seconds) points_of[s.db_line] += s.points;
   std::vector<RejectedLine> rejected;
-  for (const auto& [line, offsets] : offsets_of_line) {
-    if (points_of_line[line] < options.min_points) continue;
-    const double offset = Median(offsets);
-    if (std::abs(offset) > options.max_offset_m) {
-      rejected.push_back({line, points_of_line[line], offset});
+  for (const auto& [line, offset] : worst_lines) {
+    for (const auto& [db_line, group] : painted) {
+      if (group == line)
+        rejected.push_back({db_line, points_of[db_line], offset});
     }
   }
-  std::sort(rejected.begin(), rejected.end(),
-            [](const RejectedLine& a, const RejectedLine& b) {
-              return std::abs(a.offset_m) > std::abs(b.offset_m);
-            });
+  std::stable_sort(rejected.begin(), rejected.end(),
+                   [](const RejectedLine& a, const RejectedLine& b) {
+                     return std::abs(a.offset_m) > std::abs(b.offset_m);
+                   });
+  if (checked != nullptr) {
+    checked->clear();
+    for (const auto& [db_line, group] : painted) {
+      if (checked_painted.count(group)) checked->insert(db_line);
+    }
+  }
   kept->clear();
   for (const LinePointMatch& m : matches) {
-    const bool bad = std::any_of(
-        rejected.begin(), rejected.end(),
-        [&](const RejectedLine& r) { return r.db_line == m.db_line; });
-    if (!bad) kept->push_back(m);
+    const auto group = painted.find(m.db_line);
+    if (group == painted.end() || !excluded.count(group->second)) {
+      kept->push_back(m);
+    }
   }
   return rejected;
 }

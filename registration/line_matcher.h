@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -102,7 +103,7 @@ std::vector<LinePointMatch> MatchLinePoints(
 // seen alone cannot be checked and is kept (the adjustment's robust loss
 // remains).
 struct LineConsistencyOptions {
-  double window_s = 10.0;
+  double window_s = 2.0;
   double max_offset_m = 0.15;
   int min_points = 5;
   // Other lines count as parallel when |cos| of their normals exceeds this.
@@ -119,10 +120,14 @@ struct RejectedLine {
 
 // Splits `matches` (of points at `point_time[m.point]`) into the kept ones
 // and the database lines rejected as inconsistent, largest offset first.
+// `checked` (optional): the kept database lines that another painted line
+// vouched for (at least min_points points compared); a line seen alone is
+// kept but not checked.
 std::vector<RejectedLine> RejectInconsistentLines(
     const std::vector<LinePointMatch>& matches,
     const std::vector<double>& point_time,
-    const LineConsistencyOptions& options, std::vector<LinePointMatch>* kept);
+    const LineConsistencyOptions& options, std::vector<LinePointMatch>* kept,
+    std::set<int>* checked = nullptr);
 
 }  // namespace zebrageo
 

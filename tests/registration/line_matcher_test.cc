@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+
+#include "registration/line_offset.h"
 
 namespace zebrageo {
 namespace {
@@ -181,6 +184,104 @@ TEST(RejectInconsistentLines, KeepsLinesThatAgreeOrCannotBeChecked) {
                                       LineConsistencyOptions(), &kept)
                   .empty());
   EXPECT_EQ(kept.size(), alone_matches.size());
+}
+
+// A dashed centre line repainted 0.3 m over, its dashes each a database
+// line of their own: the dashes are one painted line and vote once, so
+// they are rejected, not the two solid lines they outnumber. The solid
+// lines are checked (vouched for by another line).
+TEST(RejectInconsistentLines, ADashedLineOfManyPiecesVotesOnce) {
+  const auto db = Street();
+  SeenStreet seen;
+  const Eigen::Vector3d drift(0.4, -0.25, 0.1);
+  auto add = [&](const std::vector<LinePointEnu>& line) {
+    for (const LinePointEnu& p : line) {
+      seen.points.push_back(p);
+      seen.time.push_back(p.p_enu.x() / 10.0);
+    }
+  };
+  add(Seen(1, "lane_solid", -3.2, 1, 99, drift));
+  add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
+  for (double x = 0; x < 100; x += 9) {
+    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.3, x + 0.5, x + 2.5,
+             drift));
+  }
+  const auto matches = MatchLinePoints(seen.points, db, LineMatchOptions());
+  std::vector<LinePointMatch> kept;
+  std::set<int> checked;
+  const auto rejected = RejectInconsistentLines(
+      matches, seen.time, LineConsistencyOptions(), &kept, &checked);
+  ASSERT_FALSE(rejected.empty());
+  for (const RejectedLine& r : rejected) {
+    EXPECT_EQ(db[r.db_line].type, "lane_dashed");
+    EXPECT_NEAR(std::abs(r.offset_m), 0.3, 0.05);
+  }
+  EXPECT_TRUE(checked.count(0));
+  EXPECT_TRUE(checked.count(1));
+  for (const LinePointMatch& m : kept) {
+    EXPECT_EQ(db[m.db_line].type, "lane_solid");
+  }
+}
+
+// The street seen from a trajectory `across` metres off to the right (the
+// road runs east: left is north), 10 m/s.
+struct Offsets {
+  std::vector<LateralOffset> windows;
+  SeenStreet seen;
+};
+Offsets SearchStreet(double across, bool centre_only) {
+  Offsets out;
+  const Eigen::Vector3d drift(0.3, -across, 0.0);
+  auto add = [&](const std::vector<LinePointEnu>& line) {
+    for (const LinePointEnu& p : line) {
+      out.seen.points.push_back(p);
+      out.seen.time.push_back(p.p_enu.x() / 10.0);
+    }
+  };
+  if (!centre_only) {
+    add(Seen(1, "lane_solid", -3.2, 1, 99, drift));
+    add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
+  }
+  for (double x = 0; x < 100; x += 9) {
+    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5, x + 2.5,
+             drift));
+  }
+  const std::vector<Eigen::Vector2d> left(out.seen.points.size(),
+                                          Eigen::Vector2d::UnitY());
+  out.windows = SearchLateralOffsets(out.seen.points, out.seen.time, left,
+                                     Street(), LateralOffsetOptions());
+  return out;
+}
+
+// 1.6 m off: nearer the next line than its own for the nearest-line
+// matcher (1.6 of 3.2 m), found by the lines voting together.
+TEST(SearchLateralOffsets, FindsADriftOfHalfALaneFromTheLinesTogether) {
+  const Offsets found = SearchStreet(1.6, false);
+  ASSERT_GE(found.windows.size(), 5u);
+  for (const LateralOffset& w : found.windows) {
+    if (w.start_s > 9.0) continue;  // the last dash's end alone
+    EXPECT_TRUE(w.decided) << "window at " << w.start_s << ": " << w.points
+                           << " points against " << w.runner_up_points;
+    EXPECT_NEAR(w.offset_m, 1.6, 0.02);
+    EXPECT_GT(w.spread_m, 6.0);
+  }
+}
+
+// One painted line fits wherever a line of its kind is: undecided.
+TEST(SearchLateralOffsets, OneLineAloneDecidesNothing) {
+  const Offsets found = SearchStreet(0.5, true);
+  ASSERT_FALSE(found.windows.empty());
+  for (const LateralOffset& w : found.windows) EXPECT_FALSE(w.decided);
+}
+
+TEST(LateralOffsetOptions, CheckNamesTheProblem) {
+  LateralOffsetOptions options;
+  EXPECT_EQ(options.Check(), "");
+  options.min_ratio = 0.5;
+  EXPECT_NE(options.Check().find("min_ratio"), std::string::npos);
+  options = LateralOffsetOptions();
+  options.bin_m = 0.0;
+  EXPECT_NE(options.Check().find("bin_m"), std::string::npos);
 }
 
 }  // namespace
