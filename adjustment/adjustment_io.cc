@@ -71,6 +71,7 @@ AdjustmentRecord RecordOf(const AdjustmentData& data,
   r.max_correction_horizontal_m = s.max_correction_horizontal_m;
   r.max_correction_vertical_m = s.max_correction_vertical_m;
   r.rms_correction_horizontal_m = s.rms_correction_horizontal_m;
+  r.road_lines_only = s.line_control_only;
   r.posterior_sd_computed = s.covariance_computed;
   r.median_posterior_sd_horizontal_m = s.median_posterior_sd_horizontal_m;
   r.median_posterior_sd_vertical_m = s.median_posterior_sd_vertical_m;

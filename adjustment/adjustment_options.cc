@@ -52,6 +52,7 @@ std::string AdjustmentOptions::Check() const {
       {"blunder_sigma_floor_m", blunder_sigma_floor_m},
       {"tie_sigma_px", tie_sigma_px},
       {"line_loss_scale", line_loss_scale},
+      {"line_discrepancy_bin_s", line_discrepancy_bin_s},
       {"boresight_sigma_rad", boresight_sigma_rad},
       {"lever_arm_sigma_m", lever_arm_sigma_m},
       {"vertical_slip_sigma_rad", vertical_slip_sigma_rad},
@@ -100,6 +101,10 @@ std::string AdjustmentOptions::Check() const {
   if (min_crossings_for_tau < 2) {
     return Violation("min_crossings_for_tau", min_crossings_for_tau,
                      "must be >= 2");
+  }
+  if (line_discrepancy_min_points < 1) {
+    return Violation("line_discrepancy_min_points", line_discrepancy_min_points,
+                     "must be >= 1");
   }
   if (max_variance_iterations < 0) {
     return Violation("max_variance_iterations", max_variance_iterations,

@@ -171,7 +171,7 @@ void AdjustmentProblem::AddKnotPriors() {
   const double dt = state_->correction.knot_spacing();
   for (Knot& k : knots) problem_->AddParameterBlock(k.data(), kKnotSize);
   num_pose_blocks_ = n;
-  HoldAttitudeAxes();
+  HoldAxes();
   const Eigen::Matrix<double, 6, 1> sigma = state_->model.Sigma();
   const Eigen::Matrix<double, 6, 1> level = state_->model.LevelSigma();
   const Eigen::Matrix<double, 6, 1> tau = state_->model.Tau();
@@ -207,13 +207,14 @@ void AdjustmentProblem::AddKnotPriors() {
   }
 }
 
-void AdjustmentProblem::HoldAttitudeAxes() {
-  // Held axes stay at the prior's centre: the input's attitude (with its
-  // jumps, knot_prior).
+void AdjustmentProblem::HoldAxes() {
+  // Held axes stay at the prior's centre: the input's attitude and
+  // position (with its jumps, knot_prior).
   std::vector<int> held;
   for (int a = 0; a < 3; ++a) {
     if (state_->attitude_held[a]) held.push_back(a);
   }
+  if (state_->along_track_held) held.push_back(3);
   if (held.empty()) return;
   auto& knots = state_->correction.knots();
   for (size_t k = 0; k < knots.size(); ++k) {

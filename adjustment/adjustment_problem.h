@@ -53,8 +53,9 @@ class AdjustmentProblem {
                         double sigma_px,
                         std::vector<ceres::ResidualBlockId>* ids);
   void AddKnotPriors();
-  // The attitude axes of State::attitude_held fixed on every knot.
-  void HoldAttitudeAxes();
+  // The attitude axes of State::attitude_held, and the along-track
+  // position with State::along_track_held, fixed on every knot.
+  void HoldAxes();
   void AddRigPriors();
   void AddControl();
   void AddTiesAndLines();

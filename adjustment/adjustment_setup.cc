@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "adjustment/line_discrepancies.h"
 #include "adjustment/trajectory_jitter.h"
 #include "survey/math_util.h"
 
@@ -161,15 +162,24 @@ void InitialiseCorrection(const Context& context, State* state) {
 }
 
 ErrorModel InitialErrorModel(const Context& context,
-                             const std::vector<CrossingDiscrepancy>& d,
+                             const std::vector<CrossingDiscrepancy>& crossings,
                              const State& state) {
   const AdjustmentOptions& options = context.options;
   ErrorModel model;
-  std::vector<bool> use(d.size(), false);
+  std::vector<bool> use(crossings.size(), false);
   for (const ControlPoint& p : state.points) {
     if (p.status != ControlStatus::kRejected)
-      use[p.crossing] = d[p.crossing].valid;
+      use[p.crossing] = crossings[p.crossing].valid;
   }
+  // Without a control crossing, the road lines' own discrepancies: the
+  // error model is fitted on what they show across them and in height.
+  std::vector<CrossingDiscrepancy> lines;
+  if (RoadLinesOnly(options, state)) {
+    lines = LineDiscrepancies(state, options.line_discrepancy_bin_s,
+                              options.line_discrepancy_min_points);
+    use.assign(lines.size(), true);
+  }
+  const std::vector<CrossingDiscrepancy>& d = lines.empty() ? crossings : lines;
   for (int axis = 0; axis < 3; ++axis) {
     model.position_sigma_m[axis] = std::clamp(1.0, options.min_position_sigma_m,
                                               options.max_position_sigma_m);
@@ -189,6 +199,14 @@ ErrorModel InitialErrorModel(const Context& context,
               : options.min_position_sigma_m;
       model.position_tau_s[axis] = fits[axis].tau_s;
     }
+  }
+  if (!lines.empty()) {
+    // Nothing measures the along-track error (the correction is held there,
+    // State::along_track_held); the cross-track one the lines show is the
+    // best guess of its size, added to the posterior along-track.
+    model.position_sigma_m[0] = model.position_sigma_m[1];
+    model.position_level_sigma_m[0] = model.position_level_sigma_m[1];
+    model.position_tau_s[0] = model.position_tau_s[1];
   }
   std::vector<double> sd[3];
   for (const TrajectorySample& s : context.input.trajectory->samples()) {
@@ -228,6 +246,14 @@ ErrorModel InitialErrorModel(const Context& context,
             << " deg; jitter " << model.jitter_sigma_m.transpose() << " m, tau "
             << model.jitter_tau_s.transpose() << " s";
   return model;
+}
+
+bool RoadLinesOnly(const AdjustmentOptions& options, const State& state) {
+  return options.line_control_without_crossings && !state.lines.empty() &&
+         std::none_of(state.points.begin(), state.points.end(),
+                      [](const ControlPoint& p) {
+                        return p.status != ControlStatus::kRejected;
+                      });
 }
 
 }  // namespace adjustment_internal

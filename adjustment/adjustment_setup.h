@@ -23,10 +23,15 @@ void InitialiseCorrection(const Context& context, State* state);
 // The error model the adjustment starts from: the position process fitted
 // to the consistent crossings' discrepancies, the attitude from the
 // trajectory's own claimed sd, the exposures' jitter where the positions
-// show one.
+// show one. Without control crossings (RoadLinesOnly), the position
+// process is fitted to the road lines' discrepancies instead.
 ErrorModel InitialErrorModel(const Context& context,
                              const std::vector<CrossingDiscrepancy>& d,
                              const State& state);
+
+// Whether road lines are the only control: no zebra control or check
+// point left, matched line points, and line_control_without_crossings.
+bool RoadLinesOnly(const AdjustmentOptions& options, const State& state);
 
 }  // namespace adjustment_internal
 }  // namespace zebrageo

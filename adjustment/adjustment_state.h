@@ -143,6 +143,10 @@ struct State {
   // Attitude components of the correction (0..2 of a knot) held at their
   // prior centre, the input's attitude (attitude_significance.h).
   std::array<bool, 3> attitude_held{};
+  // The along-track position correction held at its prior centre (road
+  // lines alone: nothing measures it, and a weak prior would let a
+  // millimetre of height misfit on a grade move it by decimetres).
+  bool along_track_held = false;
 
   // Index of the exposure at `time` (to a microsecond), or -1.
   int ExposureIndex(double time) const;

@@ -148,10 +148,13 @@ bool RunAdjustments(const Context& context, State* state,
   const bool any_check = std::any_of(
       state->points.begin(), state->points.end(),
       [](const ControlPoint& p) { return p.status == ControlStatus::kCheck; });
-  // Without zebra control nothing holds the trajectory in place: ties, road
-  // lines and the vehicle's motion are relative (lines are matched with the
-  // trajectory the zebras corrected). The input trajectory is kept.
-  if (!solver->HasControl() && !any_check) {
+  // Without zebra control only road lines hold the trajectory, across them
+  // and in height (the error model is then fitted on them,
+  // line_discrepancies.h); ties and the vehicle's motion are relative.
+  // Without either the input trajectory is kept.
+  const bool line_control =
+      options.line_control_without_crossings && !state->lines.empty();
+  if (!solver->HasControl() && !any_check && !line_control) {
     *why_not = "no control point (no matched band vertex)";
     return false;
   }
@@ -183,7 +186,7 @@ bool RunAdjustments(const Context& context, State* state,
     *why_not = summary.message;
     return false;
   }
-  if (!solver->HasControl()) {
+  if (!solver->HasControl() && !line_control) {
     *why_not =
         "every control point was rejected as a blunder: the control "
         "disagrees with the trajectory and with itself";

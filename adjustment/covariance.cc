@@ -4,6 +4,7 @@
 #include <ceres/covariance.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -41,7 +42,15 @@ std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
   const double sigma0 = context.summary->sigma0;
   const double scale = std::max(1.0, sigma0 * sigma0);
   sample_covariance.reserve(trajectory.size());
-  for (const TrajectorySample& sample : trajectory.samples()) {
+  // An along-track correction held at the input keeps the input's
+  // uncertainty, which the lines' error model sizes (State::
+  // along_track_held).
+  const double held_along_variance =
+      state->along_track_held
+          ? std::pow(state->model.position_level_sigma_m[0], 2)
+          : 0.0;
+  for (int s = 0; s < trajectory.size(); ++s) {
+    const TrajectorySample& sample = trajectory.samples()[s];
     int first = 0;
     double w[4];
     state->correction.Basis(sample.time, &first, w);
@@ -58,7 +67,13 @@ std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
         C += w[a] * w[b] * position;
       }
     }
-    sample_covariance.push_back(scale * C);
+    C(0, 0) += held_along_variance;
+    // The knots are in the track frame at each sample (along-track, left,
+    // up): the samples' sd_* are east, north, up.
+    const Eigen::Matrix3d R_enu_track =
+        state->correction.Frame(context.dejumped.poses[s]);
+    sample_covariance.push_back(scale * R_enu_track * C *
+                                R_enu_track.transpose());
   }
   context.summary->covariance_computed = true;
   return sample_covariance;

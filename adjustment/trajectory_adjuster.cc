@@ -100,6 +100,8 @@ void SelectControl(const Context& context, const CrossingTable& crossings,
   adjustment_internal::MarkCheckCrossings(context, crossings, state);
   state->model =
       adjustment_internal::InitialErrorModel(context, discrepancies, *state);
+  state->along_track_held =
+      adjustment_internal::RoadLinesOnly(context.options, *state);
 }
 
 }  // namespace
@@ -162,6 +164,16 @@ AdjustmentResult AdjustTrajectory(
   }
   adjustment_internal::SummariseFinalState(output, state, before, after,
                                            crab_before_deg, &summary);
+  summary.corrected = adjusted;
+  summary.line_control_only = adjusted && summary.num_control_crossings == 0 &&
+                              summary.num_check_crossings == 0 &&
+                              !state.lines.empty();
+  if (summary.line_control_only) {
+    context.Warn(
+        "no zebra crossing is control: road lines alone correct the "
+        "trajectory across them and in height; the along-track position is "
+        "the input's");
+  }
   summary.time_in_seconds = Seconds(start);
   summary.usable = true;
   summary.message = adjusted ? "adjusted" : "not adjusted: " + why_not;

@@ -184,6 +184,15 @@ struct AdjustmentOptions {
   // ---------------------------------------------------- road lines
   // Cauchy loss on the point-to-line residuals (line_control.h), in sigmas.
   double line_loss_scale = 3.0;
+  // Without a control crossing, matched road lines are the control: the
+  // GNSS/INS error model is then fitted on their offsets, pooled per
+  // line_discrepancy_bin_s seconds holding at least
+  // line_discrepancy_min_points points (line_discrepancies.h); the
+  // along-track position keeps the input's. line_control_without_crossings
+  // = false keeps the input trajectory instead.
+  bool line_control_without_crossings = true;
+  double line_discrepancy_bin_s = 2.0;
+  int line_discrepancy_min_points = 5;
   // ---------------------------------------------------- tie points
   // Per pyramid scale of the feature (tie_points.h: 1.2^octave): a corner
   // found on a coarser ORB level is localised that much less precisely.
@@ -356,6 +365,11 @@ struct AdjustmentSummary {
   double median_posterior_sd_horizontal_m = 0.0;
   double median_posterior_sd_vertical_m = 0.0;
   bool covariance_computed = false;
+  // Whether the trajectory was corrected (else the poses are the input's),
+  // and whether road lines were its only control (no zebra crossing: the
+  // along-track position is the input's).
+  bool corrected = false;
+  bool line_control_only = false;
 
   bool IsUsable() const { return usable; }
   std::string BriefReport() const;

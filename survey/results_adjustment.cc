@@ -42,6 +42,12 @@ class Fields {
                        std::string("field '") + key + "': " + error.what());
     }
   }
+  // A field added after the format's first version: `fallback` when an
+  // older file lacks it.
+  template <typename T>
+  T GetOr(const char* key, T fallback) const {
+    return object_.contains(key) ? Get<T>(key) : fallback;
+  }
   double Number(const char* key) const {
     const json& value = At(key);
     if (value.is_null()) return std::numeric_limits<double>::quiet_NaN();
@@ -191,6 +197,7 @@ AdjustmentRecord RecordOf(const Fields& f) {
   r.rms_correction_horizontal_m = correction.Number("rms_horizontal");
   const Fields sd = f.Object("posterior_sd_m");
   r.posterior_sd_computed = sd.Get<bool>("computed");
+  r.road_lines_only = f.GetOr<bool>("road_lines_only", false);
   r.median_posterior_sd_horizontal_m = sd.Number("median_horizontal");
   r.median_posterior_sd_vertical_m = sd.Number("median_vertical");
   for (const json& value : f.At("rejected")) {
@@ -252,6 +259,7 @@ json AdjustmentJson(const AdjustmentRecord& r) {
   j["correction_m"] = {{"max_horizontal", r.max_correction_horizontal_m},
                        {"max_vertical", r.max_correction_vertical_m},
                        {"rms_horizontal", r.rms_correction_horizontal_m}};
+  j["road_lines_only"] = r.road_lines_only;
   j["posterior_sd_m"] = {
       {"computed", r.posterior_sd_computed},
       {"median_horizontal", r.median_posterior_sd_horizontal_m},

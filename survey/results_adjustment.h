@@ -68,6 +68,9 @@ struct AdjustmentRecord {
   double max_correction_horizontal_m = 0.0;
   double max_correction_vertical_m = 0.0;
   double rms_correction_horizontal_m = 0.0;
+  // No zebra crossing was control: road lines alone corrected the
+  // trajectory (across them and in height; along-track is the input's).
+  bool road_lines_only = false;
   bool posterior_sd_computed = false;
   double median_posterior_sd_horizontal_m = 0.0;
   double median_posterior_sd_vertical_m = 0.0;

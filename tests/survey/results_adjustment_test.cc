@@ -104,6 +104,26 @@ TEST(AdjustmentRecord, UnevaluatedCheckFiguresAreNull) {
   EXPECT_EQ(AdjustmentJson(read), j);
 }
 
+// Road lines as the only control: said in the file; a file written before
+// the field existed reads as zebra control.
+TEST(AdjustmentRecord, RoadLinesOnlyRoundTripsAndDefaultsToFalse) {
+  TemporaryFolder folder;
+  AdjustmentRecord record = SampleRecord();
+  record.road_lines_only = true;
+  const std::string path = folder.Path(kAdjustmentJsonFile);
+  WriteAdjustmentRecord(record, path);
+  EXPECT_TRUE(ReadAdjustmentRecord(path, kAdjustmentJsonFile).road_lines_only);
+  nlohmann::json j = AdjustmentJson(record);
+  j.erase("road_lines_only");
+  const std::string older = folder.Write("older.json", j.dump());
+  EXPECT_FALSE(
+      ReadAdjustmentRecord(older, kAdjustmentJsonFile).road_lines_only);
+  j["road_lines_only"] = "yes";
+  const std::string bad = folder.Write("bad.json", j.dump());
+  EXPECT_THAT(ErrorOf([&] { ReadAdjustmentRecord(bad, kAdjustmentJsonFile); }),
+              HasSubstr("field 'road_lines_only'"));
+}
+
 TEST(AdjustmentRecord, ReaderNamesTheProblem) {
   TemporaryFolder folder;
   EXPECT_THAT(ErrorOf([&] {
