@@ -18,6 +18,7 @@
 #include "pipeline/stages.h"
 #include "reconstruction/road_lines.h"
 #include "registration/line_matcher.h"
+#include "registration/line_offset.h"
 #include "survey/math_util.h"
 #include "survey/results_lines.h"
 
@@ -123,6 +124,50 @@ LinePointsEnu LinePointsInEnu(
   return out;
 }
 
+// Without a corrected trajectory: each window's points shifted across the
+// track by the offset the lines agree on (line_offset.h); the points of
+// windows without one removed.
+void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
+                           LinePointsEnu* points) {
+  std::vector<Eigen::Vector2d> left_of;
+  for (const Pose& pose : points->pose_of) {
+    // Body FRD: its y axis points right.
+    const Eigen::Vector3d right = pose.q_enu_body * Eigen::Vector3d::UnitY();
+    left_of.push_back(-right.head<2>().normalized());
+  }
+  const LateralOffsetOptions options;
+  const std::vector<LateralOffset> offsets = SearchLateralOffsets(
+      points->enu, points->time_of, left_of, database, options);
+  LinePointsEnu kept;
+  int decided = 0;
+  for (const LateralOffset& o : offsets) decided += o.decided;
+  for (size_t i = 0; i < points->enu.size(); ++i) {
+    const auto o = std::find_if(
+        offsets.begin(), offsets.end(), [&](const LateralOffset& w) {
+          return points->time_of[i] >= w.start_s &&
+                 points->time_of[i] < w.start_s + options.window_s;
+        });
+    if (o == offsets.end() || !o->decided) continue;
+    kept.enu.push_back(points->enu[i]);
+    kept.enu.back().p_enu.head<2>() += o->offset_m * left_of[i];
+    kept.source.push_back(points->source[i]);
+    kept.pose_of.push_back(points->pose_of[i]);
+    kept.time_of.push_back(points->time_of[i]);
+  }
+  LOG(INFO) << "road lines without zebra control: the cross-track offset "
+               "decided in "
+            << decided << " of " << offsets.size() << " windows of "
+            << options.window_s << " s; " << kept.enu.size() << " of "
+            << points->enu.size() << " line points kept";
+  for (const LateralOffset& o : offsets) {
+    VLOG(1) << "  window at " << o.start_s << " s: offset " << o.offset_m
+            << " m, " << o.points << " points against " << o.runner_up_points
+            << ", spread " << o.spread_m << " m"
+            << (o.decided ? "" : " (undecided)");
+  }
+  *points = std::move(kept);
+}
+
 // Warns of each rejected database line (the report's wording, so the
 // warning is listed once in report.json) and lists it in `summary`.
 void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
@@ -212,15 +257,21 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   for (const Exposure& e : data.exposures.exposures) {
     exposure_time[e.exposure_id] = e.time;
   }
-  const LinePointsEnu line_points =
+  LinePointsEnu line_points =
       LinePointsInEnu(points, exposure_time, zebra_result);
+  if (!zebra_result.summary.corrected) {
+    ShiftByLateralOffsets(DatabaseLinesEnu(data.roadmarks, data.frame),
+                          &line_points);
+  }
   const std::vector<DatabaseLineEnu> database =
       DatabaseLinesEnu(data.roadmarks, data.frame);
   const std::vector<LinePointMatch> all_matches =
       MatchLinePoints(line_points.enu, database, LineMatchOptions());
   std::vector<LinePointMatch> consistent;
-  std::vector<RejectedLine> rejected = RejectInconsistentLines(
-      all_matches, line_points.time_of, LineConsistencyOptions(), &consistent);
+  std::set<int> checked;
+  std::vector<RejectedLine> rejected =
+      RejectInconsistentLines(all_matches, line_points.time_of,
+                              LineConsistencyOptions(), &consistent, &checked);
   // A database line must also agree with the trajectory the zebra crossings
   // corrected, to what that trajectory's posterior sd allows: a line the
   // zebras place decimetres away is stale or mismatched, and would pull
@@ -229,10 +280,21 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   for (size_t i = 0; i < line_points.enu.size(); ++i) {
     sd_of_point[i] = PosteriorSdAt(zebra_result, line_points.time_of[i]);
   }
+  // Without a corrected trajectory (no zebra crossing was control) there is
+  // nothing to check the lines against but each other (the input's stated
+  // sd is no measure of its error), and a line matched alone may be its
+  // neighbour, a lane away less the drift: only lines another painted line
+  // vouched for are control.
   std::vector<LinePointMatch> matches;
-  for (const RejectedLine& r :
-       RejectLinesAwayFromTrajectory(consistent, sd_of_point, &matches)) {
-    rejected.push_back(r);
+  if (zebra_result.summary.corrected) {
+    for (const RejectedLine& r :
+         RejectLinesAwayFromTrajectory(consistent, sd_of_point, &matches)) {
+      rejected.push_back(r);
+    }
+  } else {
+    for (const LinePointMatch& m : consistent) {
+      if (checked.count(m.db_line)) matches.push_back(m);
+    }
   }
   LineControlRecord summary;
   WarnRejectedLines(rejected, database, &summary, warnings);

@@ -200,9 +200,14 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
                        "trajectory");
   }
   if (data.decisions.empty() || matched == 0) {
+    const bool lines_only = data.adjustment.is_object() &&
+                            data.adjustment.value("road_lines_only", false);
     warnings.push_back(
-        "no zebra crossing was matched: the trajectory is not "
-        "controlled anywhere");
+        lines_only ? "no zebra crossing was matched: road lines alone "
+                     "control the trajectory, across them and in height; "
+                     "along-track it is the input's"
+                   : "no zebra crossing was matched: the trajectory is not "
+                     "controlled anywhere");
   }
   for (json& s : (*report)["uncontrolled_stretches"]) {
     const bool lines = RoadLinesControl(report->value("road_lines", json()),

@@ -60,6 +60,7 @@ class MatchLinesForAdjustmentTest : public ::testing::Test {
       data_.roadmarks.lines.push_back(db);
     }
     // The zebra-corrected trajectory is the truth, its posterior sd 2 cm.
+    zebra_.summary.corrected = true;
     for (int i = 0; i <= 220; ++i) {
       TrajectorySample sample;
       sample.time = 0.1 * i;
@@ -142,6 +143,24 @@ TEST_F(MatchLinesForAdjustmentTest, ControlLiesOnThePaintAndTheStaleLineIsOut) {
   EXPECT_NEAR(std::abs(summary.rejected_lines[0].offset_m), 0.25, 0.02);
   ASSERT_FALSE(summary.stretches.empty());
   EXPECT_GT(summary.stretches[0].cross_track_points, 0);
+}
+
+// No zebra crossing corrected the trajectory, which is 1.6 m off to the
+// right: nearer the next line than its own for a nearest-line match (the
+// lanes are 3.5 m wide). The lines voting together find the offset, and
+// every control point lies on the line it was painted as.
+TEST_F(MatchLinesForAdjustmentTest, WithoutZebraControlTheLinesFindTheOffset) {
+  zebra_.summary.corrected = false;
+  for (Pose& pose : zebra_.corrected_poses) pose.p_enu.y() -= 1.6;
+  std::vector<std::string> warnings;
+  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
+      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  EXPECT_GE(static_cast<int>(control.size()), 3 * points_per_line_ * 8 / 10);
+  for (const LineControlPoint& c : control) {
+    const Eigen::Vector3d p_enu = TruePose(c.time).T_enu_body() * c.p_body;
+    EXPECT_NEAR((p_enu - c.db_point_enu).dot(c.across_enu), 0.0, 1e-3);
+    EXPECT_GT(p_enu.y(), -4.0);  // never the stale line
+  }
 }
 
 TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
