@@ -89,6 +89,7 @@ std::string MatchOptions::Check() const {
   };
   if (!positive("max_drift_m", max_drift_m) ||
       !non_negative("sd_gate_factor", sd_gate_factor) ||
+      !non_negative("max_cross_track_m", max_cross_track_m) ||
       !positive("max_heading_error_rad", max_heading_error_rad) ||
       !positive("min_band_length_m", min_band_length_m) ||
       !positive("max_band_length_m", max_band_length_m) ||

@@ -78,6 +78,11 @@ struct MatchOptions {
   double sd_gate_factor = 5.0;
   // Heading error of the measured trajectory the search allows (2 degrees).
   double max_heading_error_rad = 0.035;
+  // Cross-track error the search allows at the crossing (0: max_drift_m
+  // only). The second registration pass after an adjustment by road lines
+  // alone (rematch.cc) knows the cross-track position to centimetres and
+  // the along-track one not at all; band offsets lie across the road.
+  double max_cross_track_m = 0.0;
 
   // --- Band shape -------------------------------------------------------
   // Observed bands outside these sizes are not zebra bands (lane marks,

@@ -157,6 +157,19 @@ void AddHypothesis(const Obs& obs, Hypothesis hypothesis,
   if (!merged) list->push_back(std::move(hypothesis));
 }
 
+// Whether correction `c` moves the observed crossing across the vehicle's
+// track by no more than max_cross_track_m (always, when that is 0).
+bool WithinCrossTrackGate(const MatchOptions& options, const Obs& obs,
+                          const PoseCorrection& c) {
+  if (options.max_cross_track_m <= 0.0) return true;
+  const Eigen::Vector2d left =
+      (obs.source->pose.q_enu_body * Eigen::Vector3d::UnitY()).head<2>();
+  if (left.norm() < 1e-6) return true;
+  const Eigen::Vector2d moved = Rotation2(c.heading_rad) * obs.centroid_q +
+                                c.shift_enu_m - obs.centroid_q;
+  return std::abs(moved.dot(left.normalized())) <= options.max_cross_track_m;
+}
+
 }  // namespace
 
 void PrepareObservations(MatchState* state) {
@@ -313,7 +326,9 @@ void GenerateHypotheses(int o, MatchState* state) {
       }
       VLOG(4) << "  -> " << c.shift_enu_m.transpose() << " " << c.heading_rad
               << ": " << eval.hits.size() << " hits, own " << eval.score;
-      if (eval.hits.empty()) continue;
+      if (eval.hits.empty() || !WithinCrossTrackGate(options, obs, c)) {
+        continue;
+      }
       Hypothesis hypothesis;
       hypothesis.correction = c;
       hypothesis.main_crossing = eval.MainCrossing(index);

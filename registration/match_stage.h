@@ -79,12 +79,19 @@ MatchResult RunMatchStage(const Survey& survey,
 // posterior covariance (adjustment.json; the sd would be the input's
 // optimistic one) or with fewer than min_control_crossings crossings in the
 // adjustment (its GNSS/INS error model is estimated from them: without
-// them the posterior sd is not the trajectory's error).
+// them the posterior sd is not the trajectory's error), except after an
+// adjustment by road lines alone (adjustment.json's road_lines_only): its
+// error model comes from the lines, which hold the cross-track position
+// only, so the pass searches along-track and in heading as the first did,
+// and across the track within cross_track_gate_m.
 struct RematchOptions {
   int min_control_crossings = 3;
   double gate_m = 0.25;
   double sd_gate_factor = 5.0;
   double max_heading_error_rad = 0.005;
+  // After an adjustment by road lines alone: the cross-track gate
+  // (MatchOptions::max_cross_track_m), under half a band period.
+  double cross_track_gate_m = 0.3;
   std::string Check() const;
 };
 struct RematchSummary {

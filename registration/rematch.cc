@@ -29,6 +29,11 @@ std::string RematchOptions::Check() const {
   if (!(gate_m > 0.0) || !std::isfinite(gate_m)) {
     return "gate_m = " + std::to_string(gate_m) + ": must be finite and > 0";
   }
+  if (!(cross_track_gate_m > 0.0) || !(cross_track_gate_m < 0.5)) {
+    // Half a band period: beyond it a wrong band offset can be nearer.
+    return "cross_track_gate_m = " + std::to_string(cross_track_gate_m) +
+           ": must be in (0, 0.5)";
+  }
   if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
     return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
            ": must be finite and > 0";
@@ -52,6 +57,9 @@ std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
   if (!record->posterior_sd_computed) {
     return "the adjustment has no posterior covariance to gate it";
   }
+  // Road lines alone: their error model is fitted on many stretches of
+  // line, and the pass is gated across the track only.
+  if (record->road_lines_only) return "";
   const int crossings =
       record->counts.control_crossings + record->counts.check_crossings;
   if (crossings < min_control_crossings) {
@@ -89,9 +97,16 @@ MatchResult MatchOnAdjustedTrajectory(
     };
   }
   MatchOptions tight = options;
-  tight.max_drift_m = rematch.gate_m;
-  tight.sd_gate_factor = rematch.sd_gate_factor;
-  tight.max_heading_error_rad = rematch.max_heading_error_rad;
+  if (first.adjustment->road_lines_only) {
+    // Road lines corrected the trajectory across the track and in height:
+    // along-track and in heading it is the input's, searched as in the
+    // first pass; across it, a band offset (a metre) lies far outside.
+    tight.max_cross_track_m = rematch.cross_track_gate_m;
+  } else {
+    tight.max_drift_m = rematch.gate_m;
+    tight.sd_gate_factor = rematch.sd_gate_factor;
+    tight.max_heading_error_rad = rematch.max_heading_error_rad;
+  }
   for (const CrossingObservation& o : input.observations) {
     for (const ObservedBand& b : o.bands) {
       (*bands_of)[{o.exposure_id, o.group_id}].insert(b.band_id);
@@ -124,8 +139,8 @@ int Disagreements(const std::vector<VertexMatch>& first,
 std::vector<CrossingDecision> MergeSecondPass(
     const std::vector<CrossingDecision>& first, const MatchResult& second,
     const std::map<std::pair<int64_t, int64_t>, std::set<int64_t>>& bands_of,
-    const RematchOptions& rematch, std::vector<VertexMatch>* matches,
-    RematchSummary* summary) {
+    const RematchOptions& rematch, bool road_lines_only,
+    std::vector<VertexMatch>* matches, RematchSummary* summary) {
   std::vector<CrossingDecision> merged = first;
   for (CrossingDecision& d : merged) {
     if (d.decision == Decision::kMatched) continue;
@@ -150,9 +165,12 @@ std::vector<CrossingDecision> MergeSecondPass(
     d.decision = Decision::kMatched;
     d.crossing_id = it->crossing_id;
     d.reason = "matched with the adjusted trajectory (second pass; gate " +
-               std::to_string(rematch.gate_m).substr(0, 4) +
-               " m or 5 posterior sd): " + it->reason +
-               "; first pass: " + d.reason;
+               (road_lines_only
+                    ? std::to_string(rematch.cross_track_gate_m).substr(0, 4) +
+                          " m across the track, after road lines alone"
+                    : std::to_string(rematch.gate_m).substr(0, 4) +
+                          " m or 5 posterior sd") +
+               "): " + it->reason + "; first pass: " + d.reason;
     ++summary->added;
   }
   return merged;
@@ -197,8 +215,9 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
     LOG(WARNING) << summary.message;
     return summary;
   }
-  std::vector<CrossingDecision> merged = MergeSecondPass(
-      *first.decisions, second, bands_of, rematch, &matches, &summary);
+  std::vector<CrossingDecision> merged =
+      MergeSecondPass(*first.decisions, second, bands_of, rematch,
+                      first.adjustment->road_lines_only, &matches, &summary);
   std::ostringstream message;
   message << "second registration pass with the adjusted trajectory: "
           << summary.added << " of " << summary.observations

@@ -177,11 +177,12 @@ TEST(MatchStage, RejectsBandsOfAnExposureTheSurveyDoesNotHave) {
 // The "adjusted" trajectory of the second pass: the true poses shifted by
 // `shift_enu_m`, with a posterior sd of 3 cm, and an adjustment.json that
 // says the sd is posterior (`posterior` false: it is not) and how many
-// crossings controlled it.
+// crossings controlled it (none with `road_lines_only`).
 void WriteAdjustedTrajectory(const SyntheticScene& scene,
                              const Eigen::Vector2d& shift_enu_m, bool posterior,
                              const std::string& results,
-                             int control_crossings = 3) {
+                             int control_crossings = 3,
+                             bool road_lines_only = false) {
   std::vector<TrajectorySample> samples;
   for (const ExposurePose& e : scene.exposures) {
     Pose pose = scene.true_pose.at(e.exposure_id);
@@ -195,6 +196,7 @@ void WriteAdjustedTrajectory(const SyntheticScene& scene,
   adjustment.usable = true;
   adjustment.posterior_sd_computed = posterior;
   adjustment.counts.control_crossings = control_crossings;
+  adjustment.road_lines_only = road_lines_only;
   WriteAdjustmentRecord(adjustment, results + "/" + kAdjustmentJsonFile);
 }
 
@@ -326,6 +328,53 @@ TEST_F(SecondPassTest, WithoutEnoughControlCrossingsNothingIsDone) {
   EXPECT_NE(summary.message.find("2 control crossings"), std::string::npos)
       << summary.message;
   EXPECT_EQ(Undecided(), undecided);
+}
+
+// After an adjustment by road lines alone the cross-track position is
+// known to centimetres and the along-track one not at all: the second pass
+// searches along-track as the first did (here 1.5 m off, far beyond the
+// usual 0.25 m gate) and across within cross_track_gate_m, which leaves
+// the band offsets a metre away out.
+TEST_F(SecondPassTest, AfterRoadLinesAloneSearchesAlongTrack) {
+  const int undecided = Undecided();
+  ASSERT_GT(undecided, 0);
+  // The road runs east, the bands repeat along north (across it).
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(1.5, 0.04), true,
+                          folder_.Path("results"), 0, true);
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_GT(summary.added, 0) << summary.message;
+  EXPECT_EQ(ScoreMatches(scene_, Matches()).wrong, 0);
+  bool said = false;
+  for (const CrossingDecision& d : ReadCrossingDecisions(
+           folder_.Path("results/crossing_decisions.csv"), "decisions")) {
+    said = said || d.reason.find("after road lines alone") != std::string::npos;
+  }
+  EXPECT_TRUE(said);
+}
+
+// Lines that left the trajectory 0.6 m off across the track: the right
+// band offset is outside the gate, and so is the wrong one (0.4 m): no
+// match, and none wrong.
+TEST_F(SecondPassTest, AfterRoadLinesAloneNothingOutsideTheCrossTrackGate) {
+  const int undecided = Undecided();
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(0.0, 0.6), true,
+                          folder_.Path("results"), 0, true);
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_EQ(summary.added, 0) << summary.message;
+  EXPECT_EQ(Undecided(), undecided);
+  EXPECT_EQ(ScoreMatches(scene_, Matches()).wrong, 0);
+}
+
+TEST(RematchOptions, CrossTrackGateUnderHalfABand) {
+  RematchOptions options;
+  EXPECT_EQ(options.Check(), "");
+  options.cross_track_gate_m = 0.5;
+  EXPECT_NE(options.Check().find("cross_track_gate_m"), std::string::npos);
+  MatchOptions match;
+  match.max_cross_track_m = -1.0;
+  EXPECT_NE(match.Check().find("max_cross_track_m"), std::string::npos);
 }
 
 }  // namespace
