@@ -290,27 +290,30 @@ std::map<int, int> PaintedLines(const std::vector<LineSecond>& seconds,
   return painted;
 }
 
-// Per painted line not in `excluded`: the median of its offsets from the
-// other painted lines' displacements in the same window, and its points.
+// Per database line not in `excluded`: the median of its offsets from the
+// other painted lines' displacements in the same window, and its points;
+// a line of fewer than min_points points (a dash) takes its painted line's
+// pooled offsets (its dashes are tested together).
 std::map<int, std::pair<double, int>> LineOffsets(
     const std::vector<LineSecond>& seconds, const std::map<int, int>& painted,
     const std::set<int>& excluded, const LineConsistencyOptions& options) {
   const int64_t window = static_cast<int64_t>(std::ceil(options.window_s));
-  std::map<int, std::vector<double>> offsets_of_line;
-  std::map<int, int> points_of_line;
+  std::map<int, std::vector<double>> offsets_of_line, offsets_of_painted;
+  std::map<int, int> points_of_line, points_of_painted;
   std::map<int64_t, std::vector<double>> other_lines;
   std::vector<double> references;
   for (const LineSecond& s : seconds) {
-    const int line = painted.at(s.db_line);
-    if (excluded.count(line)) continue;
+    if (excluded.count(s.db_line)) continue;
+    const int group = painted.at(s.db_line);
     other_lines.clear();
     const auto first = std::lower_bound(
         seconds.begin(), seconds.end(), s.second - window,
         [](const LineSecond& a, int64_t t) { return a.second < t; });
     for (auto o = first; o != seconds.end() && o->second <= s.second + window;
          ++o) {
-      const int other = painted.at(o->db_line);
-      if (other == line || excluded.count(other)) continue;
+      if (painted.at(o->db_line) == group || excluded.count(o->db_line)) {
+        continue;
+      }
       const double cos = o->across.dot(s.across);
       if (std::abs(cos) < options.min_parallel_cos) continue;
       const double lateral = s.across.dot(o->position - s.position);
@@ -324,12 +327,19 @@ std::map<int, std::pair<double, int>> LineOffsets(
     for (const auto& [bin, values] : other_lines) {
       references.push_back(Median(values));
     }
-    offsets_of_line[line].push_back(s.distance_m - MiddleOf(references));
-    points_of_line[line] += s.points;
+    const double offset = s.distance_m - MiddleOf(references);
+    offsets_of_line[s.db_line].push_back(offset);
+    points_of_line[s.db_line] += s.points;
+    offsets_of_painted[group].push_back(offset);
+    points_of_painted[group] += s.points;
   }
   std::map<int, std::pair<double, int>> out;
   for (const auto& [line, offsets] : offsets_of_line) {
-    out[line] = {Median(offsets), points_of_line[line]};
+    const int group = painted.at(line);
+    out[line] = points_of_line[line] >= options.min_points
+                    ? std::make_pair(Median(offsets), points_of_line[line])
+                    : std::make_pair(Median(offsets_of_painted[group]),
+                                     points_of_painted[group]);
   }
   return out;
 }
@@ -346,64 +356,51 @@ std::vector<RejectedLine> RejectInconsistentLines(
   // otherwise outvote every dash of the centre line).
   const std::vector<LineSecond> seconds = LineSeconds(matches, point_time);
   const std::map<int, int> painted = PaintedLines(seconds, options);
-  // The worst painted line first, then the test again without it: one
-  // repainted line must not make the lines beside it look offset.
-  std::vector<std::pair<int, double>> worst_lines;  // painted line, offset
+  // The worst line first, then the test again without it: one repainted
+  // line must not make the lines beside it look offset.
+  std::vector<RejectedLine> rejected;
   std::set<int> excluded;
-  std::set<int> checked_painted;
+  std::set<int> checked_lines;
   for (;;) {
     const std::map<int, std::pair<double, int>> offsets =
         LineOffsets(seconds, painted, excluded, options);
     double worst = 0.0;
-    checked_painted.clear();
+    checked_lines.clear();
     for (const auto& [line, offset] : offsets) {
-      VLOG(2) << "painted line " << line << ": offset " << offset.first
-              << " m over " << offset.second << " points";
+      VLOG(2) << "database line " << line << " (painted line "
+              << painted.at(line) << "): offset " << offset.first << " m over "
+              << offset.second << " points";
       if (offset.second < options.min_points) continue;
-      checked_painted.insert(line);
+      checked_lines.insert(line);
       if (std::abs(offset.first) > options.max_offset_m) {
         worst = std::max(worst, std::abs(offset.first));
       }
     }
     if (worst == 0.0) break;
     // Lines as far off as the worst (two lines that disagree, each the
-    // other's reference) go together: which one is wrong is not known, and
-    // the order of the database must not decide it.
+    // other's reference; the dashes of one line) go together: which one is
+    // wrong is not known, and the order of the database must not decide.
     for (const auto& [line, offset] : offsets) {
-      if (checked_painted.count(line) &&
+      if (checked_lines.count(line) &&
           std::abs(offset.first) > options.max_offset_m &&
           std::abs(offset.first) >= worst - kTiedOffsetM) {
-        worst_lines.push_back({line, offset.first});
+        int points = 0;
+        for (const LineSecond& s : seconds) {
+          if (s.db_line == line) points += s.points;
+        }
+        rejected.push_back({line, points, offset.first});
         excluded.insert(line);
       }
-    }
-  }
-  // Every database line of a rejected painted line, with its points.
-  std::map<int, int> points_of;
-  for (const LineSecond& s : seconds) points_of[s.db_line] += s.points;
-  std::vector<RejectedLine> rejected;
-  for (const auto& [line, offset] : worst_lines) {
-    for (const auto& [db_line, group] : painted) {
-      if (group == line)
-        rejected.push_back({db_line, points_of[db_line], offset});
     }
   }
   std::stable_sort(rejected.begin(), rejected.end(),
                    [](const RejectedLine& a, const RejectedLine& b) {
                      return std::abs(a.offset_m) > std::abs(b.offset_m);
                    });
-  if (checked != nullptr) {
-    checked->clear();
-    for (const auto& [db_line, group] : painted) {
-      if (checked_painted.count(group)) checked->insert(db_line);
-    }
-  }
+  if (checked != nullptr) *checked = checked_lines;
   kept->clear();
   for (const LinePointMatch& m : matches) {
-    const auto group = painted.find(m.db_line);
-    if (group == painted.end() || !excluded.count(group->second)) {
-      kept->push_back(m);
-    }
+    if (!excluded.count(m.db_line)) kept->push_back(m);
   }
   return rejected;
 }

@@ -223,6 +223,53 @@ TEST(RejectInconsistentLines, ADashedLineOfManyPiecesVotesOnce) {
   }
 }
 
+// A solid line drawn in three pieces whose middle piece the database has
+// 0.45 m over (a section repainted since): that piece is tested on its
+// own, not pooled with the pieces it continues, and is the only one out.
+TEST(RejectInconsistentLines, AMovedPieceOfALineIsOutAlone) {
+  std::vector<DatabaseLineEnu> db = Street();
+  DatabaseLineEnu& edge = db[0];  // y = -3.2, x 0..100
+  auto piece = [&](double x0, double x1, double y) {
+    DatabaseLineEnu l = edge;
+    l.id = "edge" + std::to_string(db.size());
+    l.points = {Eigen::Vector3d(x0, y, 0), Eigen::Vector3d(x1, y, 0)};
+    return l;
+  };
+  const DatabaseLineEnu a = piece(0, 40, -3.2), b = piece(40, 70, -3.65),
+                        c = piece(70, 100, -3.2);
+  edge = a;
+  db.push_back(b);
+  db.push_back(c);
+  const int moved = static_cast<int>(db.size()) - 2;
+  // Each exposure sees a few metres of line: one reconstructed line per
+  // 10 m, each within one piece.
+  SeenStreet seen;
+  const Eigen::Vector3d drift(0.0, -0.1, 0.0);
+  auto add = [&](const std::vector<LinePointEnu>& line) {
+    for (const LinePointEnu& p : line) {
+      seen.points.push_back(p);
+      seen.time.push_back(p.p_enu.x() / 10.0);
+    }
+  };
+  for (double x = 0; x < 100; x += 10) {
+    add(Seen(200 + static_cast<int64_t>(x), "lane_solid", -3.2, x + 1, x + 9,
+             drift));
+    add(Seen(300 + static_cast<int64_t>(x), "lane_solid", 3.2, x + 1, x + 9,
+             drift));
+  }
+  for (double x = 0; x < 100; x += 9) {
+    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5, x + 2.5,
+             drift));
+  }
+  const auto matches = MatchLinePoints(seen.points, db, LineMatchOptions());
+  std::vector<LinePointMatch> kept;
+  const auto rejected = RejectInconsistentLines(
+      matches, seen.time, LineConsistencyOptions(), &kept);
+  ASSERT_EQ(rejected.size(), 1u);
+  EXPECT_EQ(rejected[0].db_line, moved);
+  EXPECT_NEAR(std::abs(rejected[0].offset_m), 0.45, 0.03);
+}
+
 // The street seen from a trajectory `across` metres off to the right (the
 // road runs east: left is north), 10 m/s.
 struct Offsets {
