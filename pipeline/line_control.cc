@@ -257,14 +257,13 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   for (const Exposure& e : data.exposures.exposures) {
     exposure_time[e.exposure_id] = e.time;
   }
+  const std::vector<DatabaseLineEnu> database =
+      DatabaseLinesEnu(data.roadmarks, data.frame);
   LinePointsEnu line_points =
       LinePointsInEnu(points, exposure_time, zebra_result);
   if (!zebra_result.summary.corrected) {
-    ShiftByLateralOffsets(DatabaseLinesEnu(data.roadmarks, data.frame),
-                          &line_points);
+    ShiftByLateralOffsets(database, &line_points);
   }
-  const std::vector<DatabaseLineEnu> database =
-      DatabaseLinesEnu(data.roadmarks, data.frame);
   const std::vector<LinePointMatch> all_matches =
       MatchLinePoints(line_points.enu, database, LineMatchOptions());
   std::vector<LinePointMatch> consistent;

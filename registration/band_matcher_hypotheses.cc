@@ -162,12 +162,13 @@ void AddHypothesis(const Obs& obs, Hypothesis hypothesis,
 bool WithinCrossTrackGate(const MatchOptions& options, const Obs& obs,
                           const PoseCorrection& c) {
   if (options.max_cross_track_m <= 0.0) return true;
-  const Eigen::Vector2d left =
+  // Body y (right): across the track, the sign does not matter.
+  const Eigen::Vector2d across =
       (obs.source->pose.q_enu_body * Eigen::Vector3d::UnitY()).head<2>();
-  if (left.norm() < 1e-6) return true;
+  if (across.norm() < 1e-6) return true;
   const Eigen::Vector2d moved = Rotation2(c.heading_rad) * obs.centroid_q +
                                 c.shift_enu_m - obs.centroid_q;
-  return std::abs(moved.dot(left.normalized())) <= options.max_cross_track_m;
+  return std::abs(moved.dot(across.normalized())) <= options.max_cross_track_m;
 }
 
 }  // namespace

@@ -103,20 +103,21 @@ TEST(MatchLinePoints, TypesAndDirectionMustAgree) {
 struct SeenStreet {
   std::vector<LinePointEnu> points;
   std::vector<double> time;  // per point
+  // Adds a reconstructed line, seen at 10 m/s.
+  void Add(const std::vector<LinePointEnu>& line) {
+    for (const LinePointEnu& p : line) {
+      points.push_back(p);
+      time.push_back(p.p_enu.x() / 10.0);
+    }
+  }
 };
 SeenStreet SeeStreet(const Eigen::Vector3d& drift, double moved_m) {
   SeenStreet seen;
-  auto add = [&](const std::vector<LinePointEnu>& line) {
-    for (const LinePointEnu& p : line) {
-      seen.points.push_back(p);
-      seen.time.push_back(p.p_enu.x() / 10.0);
-    }
-  };
-  add(Seen(1, "lane_solid", -3.2 + moved_m, 1, 99, drift));
-  add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
+  seen.Add(Seen(1, "lane_solid", -3.2 + moved_m, 1, 99, drift));
+  seen.Add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
   for (double x = 0; x < 100; x += 9) {
-    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5, x + 2.5,
-             drift));
+    seen.Add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5,
+                  x + 2.5, drift));
   }
   return seen;
 }
@@ -194,17 +195,11 @@ TEST(RejectInconsistentLines, ADashedLineOfManyPiecesVotesOnce) {
   const auto db = Street();
   SeenStreet seen;
   const Eigen::Vector3d drift(0.4, -0.25, 0.1);
-  auto add = [&](const std::vector<LinePointEnu>& line) {
-    for (const LinePointEnu& p : line) {
-      seen.points.push_back(p);
-      seen.time.push_back(p.p_enu.x() / 10.0);
-    }
-  };
-  add(Seen(1, "lane_solid", -3.2, 1, 99, drift));
-  add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
+  seen.Add(Seen(1, "lane_solid", -3.2, 1, 99, drift));
+  seen.Add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
   for (double x = 0; x < 100; x += 9) {
-    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.3, x + 0.5, x + 2.5,
-             drift));
+    seen.Add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.3, x + 0.5,
+                  x + 2.5, drift));
   }
   const auto matches = MatchLinePoints(seen.points, db, LineMatchOptions());
   std::vector<LinePointMatch> kept;
@@ -245,21 +240,15 @@ TEST(RejectInconsistentLines, AMovedPieceOfALineIsOutAlone) {
   // 10 m, each within one piece.
   SeenStreet seen;
   const Eigen::Vector3d drift(0.0, -0.1, 0.0);
-  auto add = [&](const std::vector<LinePointEnu>& line) {
-    for (const LinePointEnu& p : line) {
-      seen.points.push_back(p);
-      seen.time.push_back(p.p_enu.x() / 10.0);
-    }
-  };
   for (double x = 0; x < 100; x += 10) {
-    add(Seen(200 + static_cast<int64_t>(x), "lane_solid", -3.2, x + 1, x + 9,
-             drift));
-    add(Seen(300 + static_cast<int64_t>(x), "lane_solid", 3.2, x + 1, x + 9,
-             drift));
+    seen.Add(Seen(200 + static_cast<int64_t>(x), "lane_solid", -3.2, x + 1,
+                  x + 9, drift));
+    seen.Add(Seen(300 + static_cast<int64_t>(x), "lane_solid", 3.2, x + 1,
+                  x + 9, drift));
   }
   for (double x = 0; x < 100; x += 9) {
-    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5, x + 2.5,
-             drift));
+    seen.Add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5,
+                  x + 2.5, drift));
   }
   const auto matches = MatchLinePoints(seen.points, db, LineMatchOptions());
   std::vector<LinePointMatch> kept;
@@ -279,19 +268,13 @@ struct Offsets {
 Offsets SearchStreet(double across, bool centre_only) {
   Offsets out;
   const Eigen::Vector3d drift(0.3, -across, 0.0);
-  auto add = [&](const std::vector<LinePointEnu>& line) {
-    for (const LinePointEnu& p : line) {
-      out.seen.points.push_back(p);
-      out.seen.time.push_back(p.p_enu.x() / 10.0);
-    }
-  };
   if (!centre_only) {
-    add(Seen(1, "lane_solid", -3.2, 1, 99, drift));
-    add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
+    out.seen.Add(Seen(1, "lane_solid", -3.2, 1, 99, drift));
+    out.seen.Add(Seen(2, "lane_solid", 3.2, 1, 99, drift));
   }
   for (double x = 0; x < 100; x += 9) {
-    add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5, x + 2.5,
-             drift));
+    out.seen.Add(Seen(3 + static_cast<int64_t>(x), "lane_dashed", 0.0, x + 0.5,
+                      x + 2.5, drift));
   }
   const std::vector<Eigen::Vector2d> left(out.seen.points.size(),
                                           Eigen::Vector2d::UnitY());
