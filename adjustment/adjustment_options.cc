@@ -42,6 +42,7 @@ std::string AdjustmentOptions::Check() const {
       {"min_attitude_sigma_rad", min_attitude_sigma_rad},
       {"attitude_tau_s", attitude_tau_s},
       {"crossing_consistency_chi_square", crossing_consistency_chi_square},
+      {"two_crossings_position_sigma_m", two_crossings_position_sigma_m},
       {"vertex_sigma_px", vertex_sigma_px},
       {"stereo_covariance_scale", stereo_covariance_scale},
       {"min_stereo_sigma_m", min_stereo_sigma_m},

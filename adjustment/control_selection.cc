@@ -141,7 +141,8 @@ std::vector<GaussMarkovFit> FitAxes(
 std::vector<CrossingVerdict> SelectConsistentCrossings(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<std::string>& names,
-    const GaussMarkovFitOptions& fit_options, double chi_square_threshold) {
+    const GaussMarkovFitOptions& fit_options, double chi_square_threshold,
+    double two_crossings_sigma_m) {
   const int n = static_cast<int>(crossings.size());
   std::vector<CrossingVerdict> verdicts(n);
   std::vector<bool> active(n);
@@ -160,10 +161,17 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
       // wrong crossing cannot widen it enough to pass.
       std::vector<bool> others = active;
       others[c] = false;
-      const std::vector<GaussMarkovFit> fits =
+      std::vector<GaussMarkovFit> fits =
           count <= kMaxCrossingsForRefit
               ? FitAxes(crossings, others, fit_options)
               : all;
+      if (count == 2) {
+        // Fitted on the other crossing alone: its sigma is that crossing's
+        // offset, nothing of how the error changes.
+        for (int axis : {0, 1}) {
+          fits[axis].sigma = std::max(fits[axis].sigma, two_crossings_sigma_m);
+        }
+      }
       const double chi = LeaveOneOutChiSquare(crossings, others, c, fits,
                                               Eigen::Vector3d::Zero());
       VLOG(1) << "crossing " << names[c] << ": leave-one-out chi-square " << chi
@@ -224,7 +232,8 @@ void RejectInconsistentCrossings(const Context& context,
   const std::vector<CrossingVerdict> verdicts =
       adjustment_internal::SelectConsistentCrossings(
           d, crossings.names, PositionFitOptions(context.options),
-          context.options.crossing_consistency_chi_square);
+          context.options.crossing_consistency_chi_square,
+          context.options.two_crossings_position_sigma_m);
   for (size_t c = 0; c < verdicts.size(); ++c) {
     if (verdicts[c].consistent) continue;
     context.Warn(verdicts[c].reason + ": not used as control");

@@ -52,11 +52,14 @@ struct CrossingVerdict {
 };
 
 // The verdict per crossing. Crossings without a valid discrepancy are left
-// consistent (untested). `names` label the reasons.
+// consistent (untested). `names` label the reasons. With two crossings
+// left, each is tested with a horizontal sigma of at least
+// two_crossings_sigma_m (AdjustmentOptions::two_crossings_position_sigma_m).
 std::vector<CrossingVerdict> SelectConsistentCrossings(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<std::string>& names,
-    const GaussMarkovFitOptions& fit_options, double chi_square_threshold);
+    const GaussMarkovFitOptions& fit_options, double chi_square_threshold,
+    double two_crossings_sigma_m = 0.0);
 
 // The Gauss-Markov fit of each axis (along, cross, up) of the crossings
 // flagged in `use`.
