@@ -28,7 +28,11 @@ struct Context {
   AdjustmentSummary* summary;
 
   void Warn(const std::string& warning) const {
-    LOG(WARNING) << warning;
+    if (options.log_warnings) {
+      LOG(WARNING) << warning;
+    } else {
+      VLOG(1) << warning;
+    }
     summary->warnings.push_back(warning);
   }
   bool InsPoseAt(double time, Pose* pose) const {

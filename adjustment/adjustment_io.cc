@@ -29,10 +29,12 @@ std::string RequiredStageFile(const std::string& results_folder,
   return path;
 }
 
-AdjustmentRecord RecordOf(const AdjustmentData& data,
-                          const AdjustmentOptions& options,
-                          const AdjustmentResult& result,
-                          const TiePointSummary* ties) {
+}  // namespace
+
+AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
+                                    const AdjustmentOptions& options,
+                                    const AdjustmentResult& result,
+                                    const TiePointSummary* ties) {
   const AdjustmentSummary& s = result.summary;
   AdjustmentRecord r;
   r.usable = s.usable;
@@ -113,6 +115,8 @@ AdjustmentRecord RecordOf(const AdjustmentData& data,
   r.warnings.insert(r.warnings.end(), s.warnings.begin(), s.warnings.end());
   return r;
 }
+
+namespace {
 
 // cameras.txt of a COLMAP text model: the rig's cameras, FULL_OPENCV.
 void WriteColmapCameras(const Rig& rig, const std::string& path) {
@@ -426,7 +430,8 @@ AdjustmentRecord WriteAdjustmentResults(const AdjustmentData& data,
   WriteGcpResiduals(GcpResidualsOf(result.control_points),
                     out(kGcpResidualsFile));
   WriteAdjustedBands(result.bands, out(kBandsGeoJsonFile));
-  const AdjustmentRecord record = RecordOf(data, options, result, tie_summary);
+  const AdjustmentRecord record =
+      AdjustmentRecordOf(data, options, result, tie_summary);
   WriteAdjustmentRecord(record, out(kAdjustmentJsonFile));
   const nlohmann::json summary = AdjustmentJson(record);
   nlohmann::json report;

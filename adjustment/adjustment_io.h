@@ -66,6 +66,13 @@ AdjustmentData AdjustmentDataOf(const Survey& survey,
                                 std::vector<ReconstructedVertex> vertices,
                                 std::vector<VertexMatch> matches);
 
+// What adjustment.json holds of `result` (WriteAdjustmentResults writes
+// it); `ties` may be null (no tie points).
+AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
+                                    const AdjustmentOptions& options,
+                                    const AdjustmentResult& result,
+                                    const TiePointSummary* ties);
+
 // Writes every output listed above into `results_folder` (created if
 // needed). `tie_summary` may be null (no tie points). Throws
 // std::runtime_error when a file cannot be written. Returns what

@@ -243,6 +243,14 @@ struct AdjustmentOptions {
   double boresight_sigma_rad = DegToRad(0.2);
   double lever_arm_sigma_m = 0.02;
 
+  // ---------------------------------------------------- reporting
+  // Warnings go to summary.warnings and, when true, to the log as
+  // warnings. False for a trial adjustment the user never gets (the road
+  // lines alone, on which the second registration pass searches: its
+  // warnings would describe a result nobody receives); they are logged at
+  // VLOG(1).
+  bool log_warnings = true;
+
   // ---------------------------------------------------- covariance
   // Posterior covariance of the corrected positions (trajectory sd_* of the
   // output) when the problem has at most this many knots.

@@ -145,7 +145,11 @@ bool UpdateVarianceComponents(const AdjustmentOptions& options,
           " deg (robust RMS) where the vehicle's sideslip is a tenth of a "
           "degree: its positions are too noisy for the vehicle-motion "
           "constraint, which is not used";
-      LOG(WARNING) << warning;
+      if (options.log_warnings) {
+        LOG(WARNING) << warning;
+      } else {
+        VLOG(1) << warning;
+      }
       warnings->push_back(warning);
       state->motion.clear();
       changed = true;

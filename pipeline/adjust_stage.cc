@@ -11,6 +11,7 @@
 #include "adjustment/trajectory_adjuster.h"
 #include "pipeline/exit_codes.h"
 #include "pipeline/stages.h"
+#include "registration/match_stage.h"
 #include "survey/atomic_file.h"
 #include "survey/output_crs.h"
 #include "survey/results.h"
@@ -30,6 +31,39 @@ std::set<int64_t> SkippedExposureIds(StageResults* results) {
 }
 
 }  // namespace
+
+AdjustmentResult AdjustWithRoadLines(
+    const AdjustmentData& data, AdjustmentInput input,
+    const AdjustmentOptions& options,
+    const std::vector<ReconstructedLinePoint>* line_points,
+    const std::string& results_folder, std::vector<std::string>* warnings,
+    const ProgressListener& progress) {
+  StepProgress step(progress, "adjust");
+  AdjustmentResult result = AdjustTrajectory(options, input, step.Callback());
+  step.Finish();
+  if (line_points == nullptr || !result.summary.IsUsable()) return result;
+  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
+      data, options, result, line_points, results_folder, warnings);
+  if (control.empty()) return result;
+  input.line_points = &control;
+  StepProgress line_step(progress, "adjust with lines");
+  result = AdjustTrajectory(options, input, line_step.Callback());
+  line_step.Finish();
+  return result;
+}
+
+bool SecondPassOnRoadLines(const AdjustmentRecord& record,
+                           const std::vector<CrossingDecision>& decisions,
+                           bool lines) {
+  if (!lines || record.road_lines_only) return false;
+  const int crossings =
+      record.counts.control_crossings + record.counts.check_crossings;
+  if (crossings >= RematchOptions().min_control_crossings) return false;
+  for (const CrossingDecision& d : decisions) {
+    if (d.decision != Decision::kMatched) return true;
+  }
+  return false;
+}
 
 std::vector<std::string> RunAdjustStage(const Survey& survey,
                                         StageResults* results,
@@ -63,21 +97,10 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
   AdjustmentInput input = data.Input();
   if (use_ties) input.tie_tracks = &tracks;
 
-  StepProgress step(progress, "adjust");
-  AdjustmentResult result = AdjustTrajectory(options, input, step.Callback());
-  step.Finish();
   std::vector<std::string> warnings = data.warnings;
-  if (lines && result.summary.IsUsable()) {
-    const std::vector<LineControlPoint> line_points =
-        MatchLinesForAdjustment(data, options, result, results->LinePoints(),
-                                results_folder, &warnings);
-    if (!line_points.empty()) {
-      input.line_points = &line_points;
-      StepProgress line_step(progress, "adjust with lines");
-      result = AdjustTrajectory(options, input, line_step.Callback());
-      line_step.Finish();
-    }
-  }
+  AdjustmentResult result = AdjustWithRoadLines(
+      data, input, options, lines ? results->LinePoints() : nullptr,
+      results_folder, &warnings, progress);
   if (!result.summary.IsUsable()) {
     // A solver's message ("Ceres failed: ...") names no input: the survey's
     // warnings (gaps, rates, with their lines and times) may.
@@ -115,6 +138,38 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
   AddOutputCrs(survey, results_folder);
   LOG(INFO) << "adjust: " << result.summary.BriefReport();
   return warnings;
+}
+
+std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
+    const AdjustmentData& data,
+    const std::vector<ReconstructedLinePoint>* line_points,
+    const AdjustmentOptions& user_options) {
+  if (line_points == nullptr || line_points->empty() ||
+      !user_options.line_control_without_crossings) {
+    return std::nullopt;
+  }
+  AdjustmentOptions options = user_options;
+  options.log_warnings = false;  // a trial: the user gets another result
+  AdjustmentInput input = data.Input();
+  const std::vector<VertexMatch> no_matches;
+  input.matches = &no_matches;
+  // Without control the adjustment keeps the input trajectory; the lines
+  // are then placed by the cross-track offsets they agree on.
+  const AdjustmentResult uncorrected = AdjustTrajectory(options, input);
+  if (!uncorrected.summary.IsUsable()) return std::nullopt;
+  std::vector<std::string> warnings;
+  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
+      data, options, uncorrected, line_points, "", &warnings);
+  if (control.empty()) return std::nullopt;
+  input.line_points = &control;
+  AdjustmentResult result = AdjustTrajectory(options, input);
+  if (!result.summary.IsUsable() || !result.summary.line_control_only) {
+    return std::nullopt;
+  }
+  RoadLinesAdjustment out;
+  out.record = AdjustmentRecordOf(data, options, result, nullptr);
+  out.trajectory = std::move(result.corrected_samples);
+  return out;
 }
 
 }  // namespace zebrageo

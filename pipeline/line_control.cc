@@ -172,7 +172,7 @@ void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
 // warning is listed once in report.json) and lists it in `summary`.
 void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
                        const std::vector<DatabaseLineEnu>& database,
-                       LineControlRecord* summary,
+                       bool log_warnings, LineControlRecord* summary,
                        std::vector<std::string>* warnings) {
   for (const RejectedLine& r : rejected) {
     const DatabaseLineEnu& line = database[r.db_line];
@@ -181,7 +181,11 @@ void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
       << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
       << " m across from where the other lines put it: repainted or stale, "
          "not used as control";
-    LOG(WARNING) << w.str();
+    if (log_warnings) {
+      LOG(WARNING) << w.str();
+    } else {
+      VLOG(1) << w.str();
+    }
     warnings->push_back(w.str());
     summary->rejected_lines.push_back(
         {line.id, line.type, r.points, r.offset_m});
@@ -296,7 +300,8 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     }
   }
   LineControlRecord summary;
-  WarnRejectedLines(rejected, database, &summary, warnings);
+  WarnRejectedLines(rejected, database, options.log_warnings, &summary,
+                    warnings);
 
   std::vector<LineMatch> rows;
   // Per 30 s stretch: matches, and the directions controlled.
@@ -330,6 +335,8 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
                     m.across_enu.head<2>(), m.distance_m, m.height_m,
                     cross_track});
   }
+  LogLineControl(matches.size(), points.size(), stretch_s, stretches);
+  if (results_folder.empty()) return control;
   const std::filesystem::path folder(results_folder);
   WriteLineMatches(rows, (folder / kLineMatchesFile).string());
   summary.stretch_s = stretch_s;
@@ -341,7 +348,6 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
                                  start_time + k * stretch_s, s[0], s[1], s[2]});
   }
   WriteLineControl(summary, (folder / kLineControlFile).string());
-  LogLineControl(matches.size(), points.size(), stretch_s, stretches);
   return control;
 }
 

@@ -3,6 +3,7 @@
 #include <glog/logging.h>
 #include <sys/resource.h>
 
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -70,6 +71,9 @@ std::vector<std::string> Match(const Survey& survey, StageResults* results,
 }
 
 // The second registration pass on what the adjustment left in `results`.
+// With too few crossings in it, on the trajectory the road lines alone
+// correct: they hold the cross-track position, across which a zebra's band
+// offsets lie, whatever the crossings' error model.
 RematchSummary Rematch(const Survey& survey, StageResults* results,
                        const RunOptions& options) {
   RematchInput first;
@@ -78,8 +82,26 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
   first.matches = &results->Matches();
   first.decisions = &results->Decisions();
   first.adjusted_trajectory = &results->CorrectedTrajectory();
+  std::optional<RoadLinesAdjustment> lines;
+  if (first.adjustment != nullptr &&
+      SecondPassOnRoadLines(*first.adjustment, results->Decisions(),
+                            options.lines)) {
+    lines = AdjustByRoadLinesAlone(
+        AdjustmentDataOf(survey, results->Vertices(), {}),
+        results->LinePoints(), options.adjustment);
+    if (lines) {
+      first.adjustment = &lines->record;
+      first.adjusted_trajectory = &lines->trajectory;
+    }
+  }
   RematchSummary rematch = RematchWithAdjustedTrajectory(
       survey, first, options.matching, RematchOptions());
+  if (lines) {
+    rematch.message +=
+        " (searched on the trajectory the road lines alone "
+        "corrected: too few crossings for the adjustment's "
+        "error model)";
+  }
   WriteRematchResults(rematch, results->folder());
   if (rematch.added > 0) {
     results->SetMatches(std::move(rematch.matches),
@@ -94,9 +116,13 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
 std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
                                 const RunOptions& options,
                                 const ProgressListener& progress) {
-  std::vector<std::string> warnings =
-      RunAdjustStage(survey, results, options.adjustment, options.tie_points,
-                     options.lines, progress);
+  // With the second pass, the first adjustment may not be the result: its
+  // warnings go to the report (and stderr, tools/run_command.cc) only if
+  // it is.
+  AdjustmentOptions first = options.adjustment;
+  first.log_warnings = !options.rematch;
+  std::vector<std::string> warnings = RunAdjustStage(
+      survey, results, first, options.tie_points, options.lines, progress);
   if (!options.rematch) return warnings;
   // Crossings the first pass could not decide, matched again with the
   // adjusted trajectory.

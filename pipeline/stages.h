@@ -10,6 +10,7 @@
 #define ZEBRAGEO_PIPELINE_STAGES_H_
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,11 +61,49 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
                                         bool tie_points, bool lines,
                                         const ProgressListener& progress);
 
+// The adjustment of `input` (zebra control), then, with `line_points`,
+// again with the road lines matched on its trajectory
+// (MatchLinesForAdjustment, below; files written into results_folder
+// unless it is ""). What RunAdjustStage runs; progress steps "adjust" and
+// "adjust with lines"; `progress` may be null.
+AdjustmentResult AdjustWithRoadLines(
+    const AdjustmentData& data, AdjustmentInput input,
+    const AdjustmentOptions& options,
+    const std::vector<ReconstructedLinePoint>* line_points,
+    const std::string& results_folder, std::vector<std::string>* warnings,
+    const ProgressListener& progress);
+
+// Whether the second registration pass should search on the trajectory the
+// road lines alone correct (AdjustByRoadLinesAlone) rather than on the
+// adjustment's (`record`): with road lines, an adjustment that had too
+// few crossings to trust its error model (RematchOptions::
+// min_control_crossings: rematch.cc would skip the pass) and observations
+// left undecided.
+bool SecondPassOnRoadLines(const AdjustmentRecord& record,
+                           const std::vector<CrossingDecision>& decisions,
+                           bool lines);
+
+// The trajectory of `data` corrected by the road lines alone (its zebra
+// matches left out: adjustment.json's road_lines_only), and what
+// adjustment.json would hold of it; nullopt without line points or when
+// no line could be control. Writes nothing. The second registration pass
+// (pipeline.cc) searches on it when the zebra crossings the adjustment
+// used are too few to trust its error model.
+struct RoadLinesAdjustment {
+  std::vector<TrajectorySample> trajectory;
+  AdjustmentRecord record;
+};
+std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
+    const AdjustmentData& data,
+    const std::vector<ReconstructedLinePoint>* line_points,
+    const AdjustmentOptions& options);
+
 // The reconstructed road-line points (what reconstructed_lines.csv holds)
 // matched to the database lines with the trajectory of `zebra_result`,
 // database lines that disagree with the others rejected (warnings), as
 // control for the adjustment; writes line_matches.csv and
-// line_control.json into results_folder. Empty when reconstructed_lines is
+// line_control.json into results_folder (nothing when it is ""). Empty
+// when reconstructed_lines is
 // null (reconstructed without lines) or the database has no lines.
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
