@@ -30,6 +30,19 @@ std::set<int64_t> SkippedExposureIds(StageResults* results) {
   return ids;
 }
 
+// The times of the line control points that hold the position across
+// their line (not the height alone), sorted.
+std::vector<double> CrossTrackTimes(
+    const std::vector<LineControlPoint>& control) {
+  std::vector<double> times;
+  for (const LineControlPoint& c : control) {
+    if (c.sqrt_information.row(0).norm() > 0.0) times.push_back(c.time);
+  }
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  return times;
+}
+
 }  // namespace
 
 AdjustmentResult AdjustWithRoadLines(
@@ -37,7 +50,8 @@ AdjustmentResult AdjustWithRoadLines(
     const AdjustmentOptions& options,
     const std::vector<ReconstructedLinePoint>* line_points,
     const std::string& results_folder, std::vector<std::string>* warnings,
-    const ProgressListener& progress) {
+    const ProgressListener& progress, std::vector<double>* line_control_times) {
+  if (line_control_times != nullptr) line_control_times->clear();
   StepProgress step(progress, "adjust");
   AdjustmentResult result = AdjustTrajectory(options, input, step.Callback());
   step.Finish();
@@ -45,6 +59,9 @@ AdjustmentResult AdjustWithRoadLines(
   const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
       data, options, result, line_points, results_folder, warnings);
   if (control.empty()) return result;
+  if (line_control_times != nullptr) {
+    *line_control_times = CrossTrackTimes(control);
+  }
   input.line_points = &control;
   StepProgress line_step(progress, "adjust with lines");
   result = AdjustTrajectory(options, input, line_step.Callback());
@@ -169,6 +186,7 @@ std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
   RoadLinesAdjustment out;
   out.record = AdjustmentRecordOf(data, options, result, nullptr);
   out.trajectory = std::move(result.corrected_samples);
+  out.line_control_times = CrossTrackTimes(control);
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <glog/logging.h>
 #include <sys/resource.h>
 
+#include <filesystem>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -82,6 +83,18 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
   first.matches = &results->Matches();
   first.decisions = &results->Decisions();
   first.adjusted_trajectory = &results->CorrectedTrajectory();
+  // After road lines alone, the pass searches where they held the
+  // cross-track position: line_matches.csv's exposures.
+  std::vector<double> line_times;
+  if (first.adjustment != nullptr && first.adjustment->road_lines_only &&
+      options.lines) {
+    const std::string path = results->folder() + "/" + kLineMatchesFile;
+    if (std::filesystem::exists(path)) {
+      line_times = LineControlTimes(ReadLineMatches(path, kLineMatchesFile),
+                                    survey.exposures);
+    }
+  }
+  first.line_control_times = &line_times;
   std::optional<RoadLinesAdjustment> lines;
   if (first.adjustment != nullptr &&
       SecondPassOnRoadLines(*first.adjustment, results->Decisions(),
@@ -92,6 +105,7 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
     if (lines) {
       first.adjustment = &lines->record;
       first.adjusted_trajectory = &lines->trajectory;
+      first.line_control_times = &lines->line_control_times;
     }
   }
   RematchSummary rematch = RematchWithAdjustedTrajectory(

@@ -65,13 +65,17 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
 // again with the road lines matched on its trajectory
 // (MatchLinesForAdjustment, below; files written into results_folder
 // unless it is ""). What RunAdjustStage runs; progress steps "adjust" and
-// "adjust with lines"; `progress` may be null.
+// "adjust with lines"; `progress` may be null. *line_control_times (when
+// not null): the times of the line points that held the cross-track
+// position (the second pass searches only near them after road lines
+// alone).
 AdjustmentResult AdjustWithRoadLines(
     const AdjustmentData& data, AdjustmentInput input,
     const AdjustmentOptions& options,
     const std::vector<ReconstructedLinePoint>* line_points,
     const std::string& results_folder, std::vector<std::string>* warnings,
-    const ProgressListener& progress);
+    const ProgressListener& progress,
+    std::vector<double>* line_control_times = nullptr);
 
 // Whether the second registration pass should search on the trajectory the
 // road lines alone correct (AdjustByRoadLinesAlone) rather than on the
@@ -92,6 +96,9 @@ bool SecondPassOnRoadLines(const AdjustmentRecord& record,
 struct RoadLinesAdjustment {
   std::vector<TrajectorySample> trajectory;
   AdjustmentRecord record;
+  // Where the lines held the cross-track position (RematchInput::
+  // line_control_times).
+  std::vector<double> line_control_times;
 };
 std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
     const AdjustmentData& data,

@@ -22,6 +22,7 @@
 #include "registration/roadmark_index.h"
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
+#include "survey/results_lines.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
@@ -90,8 +91,16 @@ struct RematchOptions {
   double sd_gate_factor = 5.0;
   double max_heading_error_rad = 0.005;
   // After an adjustment by road lines alone: the cross-track gate
-  // (MatchOptions::max_cross_track_m), under half a band period.
+  // (MatchOptions::max_cross_track_m), under half a band period...
   double cross_track_gate_m = 0.3;
+  // ... where the lines measured it: only observations within this time of
+  // a line point that held the cross-track position are searched.
+  // Between such points the position is interpolated, and a GNSS/INS
+  // error switching by a metre there (multipath) would put a crossing a
+  // band off. At a metre per 40 m (MatchOptions::max_drift_per_metre) and
+  // 12 m/s, a second moves it 0.3 m: with the 0.3 m gate, a band offset
+  // (1 m) stays out. (Geometry sweep 1-500: 2 s let 8 wrong matches in.)
+  double max_line_control_gap_s = 1.0;
   std::string Check() const;
 };
 struct RematchSummary {
@@ -116,7 +125,15 @@ struct RematchInput {
   // The image evidence (MatchInput::paint_probe); empty: the survey's
   // images seen with the adjusted trajectory (ImagePaintProbe).
   decltype(MatchInput::paint_probe) paint_probe;
+  // After road lines alone: the times of the line points that held the
+  // cross-track position (LineControlTimes); null: none, and the pass
+  // searches nothing.
+  const std::vector<double>* line_control_times = nullptr;
 };
+// The times of the exposures of line_matches.csv's rows that constrain
+// the position across their line, sorted.
+std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
+                                     const ExposureTable& exposures);
 // Writes nothing (WriteRematchResults does).
 RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
                                              const RematchInput& first,

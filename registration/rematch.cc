@@ -34,6 +34,11 @@ std::string RematchOptions::Check() const {
     return "cross_track_gate_m = " + std::to_string(cross_track_gate_m) +
            ": must be in (0, 0.5)";
   }
+  if (!(max_line_control_gap_s >= 0.0) ||
+      !std::isfinite(max_line_control_gap_s)) {
+    return "max_line_control_gap_s = " +
+           std::to_string(max_line_control_gap_s) + ": must be finite and >= 0";
+  }
   if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
     return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
            ": must be finite and > 0";
@@ -70,6 +75,12 @@ std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
   return "";
 }
 
+// Whether `sorted` holds a value within `gap` of `t`.
+bool NearAny(const std::vector<double>& sorted, double t, double gap) {
+  const auto it = std::lower_bound(sorted.begin(), sorted.end(), t - gap);
+  return it != sorted.end() && *it <= t + gap;
+}
+
 // The second pass: the bands matched again on the survey as the adjustment
 // left it (its corrected trajectory), with the rematch gates. *bands_of:
 // the band ids of each observation (exposure, group).
@@ -98,6 +109,17 @@ MatchResult MatchOnAdjustedTrajectory(
   }
   MatchOptions tight = options;
   if (first.adjustment->road_lines_only) {
+    // Only where the lines measured the cross-track position.
+    const std::vector<double> none;
+    const std::vector<double>& times =
+        first.line_control_times != nullptr ? *first.line_control_times : none;
+    input.observations.erase(
+        std::remove_if(input.observations.begin(), input.observations.end(),
+                       [&](const CrossingObservation& o) {
+                         return !NearAny(times, o.time_s,
+                                         rematch.max_line_control_gap_s);
+                       }),
+        input.observations.end());
     // Road lines corrected the trajectory across the track and in height:
     // along-track and in heading it is the input's, searched as in the
     // first pass; across it, a band offset (a metre) lies far outside.
@@ -234,6 +256,22 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
   return summary;
 }
 
+std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
+                                     const ExposureTable& exposures) {
+  std::map<int64_t, double> time_of;
+  for (const Exposure& e : exposures.exposures) time_of[e.exposure_id] = e.time;
+  std::vector<double> times;
+  for (const LineMatch& row : rows) {
+    const auto t = time_of.find(row.exposure_id);
+    if (row.constrains_across && t != time_of.end()) {
+      times.push_back(t->second);
+    }
+  }
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  return times;
+}
+
 void WriteRematchResults(const RematchSummary& summary,
                          const std::string& results_folder) {
   if (summary.added == 0) return;
@@ -292,6 +330,16 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
   }
   first.adjusted_trajectory = &adjusted;
   first.vertices = &vertices;
+  // After road lines alone, where they held the cross-track position.
+  std::vector<double> line_times;
+  const fs::path line_matches = folder / kLineMatchesFile;
+  if (undecided && first.adjustment->road_lines_only &&
+      fs::exists(line_matches)) {
+    line_times = LineControlTimes(
+        ReadLineMatches(line_matches.string(), kLineMatchesFile),
+        survey.exposures);
+  }
+  first.line_control_times = &line_times;
   const RematchSummary summary =
       RematchWithAdjustedTrajectory(survey, first, options, rematch);
   WriteRematchResults(summary, results_folder);

@@ -177,12 +177,28 @@ TEST(MatchStage, RejectsBandsOfAnExposureTheSurveyDoesNotHave) {
 // The "adjusted" trajectory of the second pass: the true poses shifted by
 // `shift_enu_m`, with a posterior sd of 3 cm, and an adjustment.json that
 // says the sd is posterior (`posterior` false: it is not) and how many
-// crossings controlled it (none with `road_lines_only`).
+// crossings controlled it (none with `road_lines_only`: then
+// line_matches.csv has a line point holding the cross-track position at
+// every exposure, unless `lines_everywhere` is false: none).
 void WriteAdjustedTrajectory(const SyntheticScene& scene,
                              const Eigen::Vector2d& shift_enu_m, bool posterior,
                              const std::string& results,
                              int control_crossings = 3,
-                             bool road_lines_only = false) {
+                             bool road_lines_only = false,
+                             bool lines_everywhere = true) {
+  if (road_lines_only) {
+    std::vector<LineMatch> rows;
+    for (const ExposurePose& e : scene.exposures) {
+      if (!lines_everywhere) break;
+      LineMatch row;
+      row.exposure_id = e.exposure_id;
+      row.line_id = e.exposure_id;
+      row.db_line = "lane";
+      row.across_enu = Eigen::Vector2d(0.0, 1.0);
+      rows.push_back(row);
+    }
+    WriteLineMatches(rows, results + "/" + kLineMatchesFile);
+  }
   std::vector<TrajectorySample> samples;
   for (const ExposurePose& e : scene.exposures) {
     Pose pose = scene.true_pose.at(e.exposure_id);
@@ -367,11 +383,28 @@ TEST_F(SecondPassTest, AfterRoadLinesAloneNothingOutsideTheCrossTrackGate) {
   EXPECT_EQ(ScoreMatches(scene_, Matches()).wrong, 0);
 }
 
+// Where no line held the cross-track position it is interpolated between
+// stretches of line (a multipath switch there puts it a metre off): the
+// pass searches nothing there, even with a trajectory that is right.
+TEST_F(SecondPassTest, AfterRoadLinesAloneOnlyWhereTheLinesHeldIt) {
+  const int undecided = Undecided();
+  ASSERT_GT(undecided, 0);
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(1.5, 0.04), true,
+                          folder_.Path("results"), 0, true, false);
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  EXPECT_EQ(summary.added, 0) << summary.message;
+  EXPECT_EQ(Undecided(), undecided);
+}
+
 TEST(RematchOptions, CrossTrackGateUnderHalfABand) {
   RematchOptions options;
   EXPECT_EQ(options.Check(), "");
   options.cross_track_gate_m = 0.5;
   EXPECT_NE(options.Check().find("cross_track_gate_m"), std::string::npos);
+  options = RematchOptions();
+  options.max_line_control_gap_s = -1.0;
+  EXPECT_NE(options.Check().find("max_line_control_gap_s"), std::string::npos);
   MatchOptions match;
   match.max_cross_track_m = -1.0;
   EXPECT_NE(match.Check().find("max_cross_track_m"), std::string::npos);
