@@ -1,18 +1,20 @@
 // `geometry_sweep [--seeds A-B] [--threads N] [--only KIND] [--max-length M]
-//                 [--verbose SEED -o DIR]`
+//                 [--no-rematch] [--no-lines] [--verbose SEED -o DIR]`
 //
 // Issue 17's geometry sweep: for each seed, a random simulated survey in
 // memory (the random preset, no images), a reconstruction and image
 // evidence synthesised from its truth with realistic behaviour (recall
-// falling with range, parked vehicles, noise growing with range), then the
-// matcher and the adjustment (zebra control only) in process, scored as
+// falling with range, parked vehicles, noise growing with range), with the
+// lane lines' points, then the matcher and the adjustment with zebra
+// crossings and road lines as `zebrageo run` does, in process, scored as
 // ../shared/tools/score_results.py scores a results folder. One line per
 // survey, then a summary: medians, 95th percentiles and worst cases, wrong
 // matches, runs worse than their input, unusable adjustments, crossings
 // matched. Exit status 1 when the sweep misses the issue's "Done when".
 //
 // --verbose SEED -o DIR writes that survey (images rendered) to DIR/survey
-// and the synthetic reconstructed_bands.csv, the sweep's matches.csv,
+// and the synthetic reconstructed_bands.csv (and reconstructed_lines.csv),
+// the sweep's matches.csv,
 // crossing_decisions.csv and poses.csv to DIR/results, to be run through
 // `zebrageo match DIR/survey -o DIR/results` and `zebrageo adjust` and
 // inspected (the real match stage reads the rendered images for its paint
@@ -74,6 +76,8 @@ int Main(int argc, char** argv) {
   app.add_flag("!--no-rematch", options.rematch,
                "match then adjust once (without the second registration "
                "pass of `zebrageo run`)");
+  app.add_flag("!--no-lines", options.lines,
+               "zebra crossings only (no synthesised road lines)");
   int log_level = -1;
   app.add_option("--log", log_level,
                  "the stages' logs to stderr, with VLOG up to this level "
@@ -100,8 +104,8 @@ int Main(int argc, char** argv) {
               << "survey in " << output << "/survey, results in " << output
               << "/results:\n  zebrageo match " << output << "/survey -o "
               << output << "/results\n  zebrageo adjust " << output
-              << "/survey -o " << output
-              << "/results --no-tie-points --no-lines\n";
+              << "/survey -o " << output << "/results --no-tie-points"
+              << (options.lines ? "" : " --no-lines") << "\n";
     return result.error.empty() ? 0 : 1;
   }
   uint64_t first = 0, last = 0;

@@ -1,7 +1,8 @@
 // Issue 17's geometry sweep as a test (ctest label "sweep"): 500 random
 // surveys in memory (the random preset, roads of at most 400 m, no images),
-// their reconstruction synthesised from the truth, through the matcher and
-// the adjustment, must meet the issue's "Done when": no wrong vertex match,
+// their bands and lane lines reconstructed synthetically from the truth,
+// through the matcher and the adjustment as `zebrageo run` does, must meet
+// the issue's "Done when": no wrong vertex match,
 // no run worse than its input in position or attitude, no unusable
 // adjustment while a consistent set of crossings exists, and at least 90 %
 // of the matchable crossings matched. `bench/geometry_sweep` runs the same

@@ -12,6 +12,7 @@
 #include "simulator/simulated_survey.h"
 #include "simulator/simulator.h"
 #include "tests/support/geometry_sweep.h"
+#include "tests/support/synthetic_lines.h"
 
 namespace zebrageo::support {
 namespace {
@@ -147,6 +148,66 @@ TEST(SynthesiseReconstruction, RecallFallsWithRange) {
   const double share = static_cast<double>(count_far(b)) / count_far(a);
   EXPECT_GT(share, 0.15);
   EXPECT_LT(share, 0.5);
+}
+
+// Horizontal distance from `p` to the painted lane lines of the street
+// (road coordinates searched from s_guess).
+double DistanceToPaintedLine(const sim::World& world, const Eigen::Vector3d& p,
+                             double s_guess) {
+  double s = 0.0, l = 0.0;
+  if (!world.road.ToRoadCoordinates(p.head<2>(), s_guess, &s, &l)) {
+    return 1e9;
+  }
+  double nearest = 1e9;
+  for (const sim::LinePiece& piece : world.lines) {
+    if (s < piece.s0 - 0.3 || s > piece.s1 + 0.3) continue;
+    nearest = std::min(nearest, std::abs(l - piece.l_m));
+  }
+  return nearest;
+}
+
+TEST(SynthesiseLinePoints, PointsLieOnThePaintedLinesWithinTheirNoise) {
+  const sim::SimulatedSurvey survey = ShortDemo();
+  ASSERT_FALSE(survey.world.lines.empty());
+  ReconstructionModel model;
+  const std::vector<ReconstructedLinePoint> points =
+      SynthesiseLinePoints(survey, model, 7);
+  const std::map<int64_t, Pose> poses = TruePoses(survey);
+  std::map<int64_t, double> s_of;
+  for (const sim::ExposureEvent& e : survey.motion.exposures) {
+    s_of[e.exposure_id] = e.s_m;
+  }
+  std::set<int64_t> lines, exposures;
+  double sum_sq = 0.0;
+  for (const ReconstructedLinePoint& p : points) {
+    const Pose& pose = poses.at(p.exposure_id);
+    const Eigen::Vector3d p_enu = pose.T_enu_body() * p.p_body;
+    const double d = DistanceToPaintedLine(
+        survey.world, p_enu,
+        s_of.at(p.exposure_id) + (p_enu - pose.p_enu).head<2>().norm());
+    // 5 sigma across the ray at 16 m, plus the along-ray part that falls
+    // across a line seen obliquely.
+    EXPECT_LT(d, 0.1) << "line " << p.line_id << " point " << p.point;
+    sum_sq += d * d;
+    EXPECT_LE((p_enu - pose.p_enu).norm(), 16.0 + 3.0);
+    // The covariance is the noise's: positive definite, centimetres.
+    EXPECT_GT(p.covariance_body.determinant(), 0.0);
+    EXPECT_LT(std::sqrt(p.covariance_body.trace()), 0.1);
+    lines.insert(p.line_id);
+    exposures.insert(p.exposure_id);
+  }
+  // Lane lines on both sides of the lane in nearly every exposure.
+  EXPECT_GT(points.size(), 10 * survey.exposures.exposures.size());
+  EXPECT_GE(exposures.size(), survey.exposures.exposures.size() * 9 / 10);
+  EXPECT_GE(lines.size(), 2 * exposures.size());
+  EXPECT_LT(std::sqrt(sum_sq / points.size()), 0.02);
+  // Deterministic in the seed, and another seed draws other noise.
+  const std::vector<ReconstructedLinePoint> again =
+      SynthesiseLinePoints(survey, model, 7);
+  ASSERT_EQ(again.size(), points.size());
+  EXPECT_EQ(again.back().p_body, points.back().p_body);
+  EXPECT_NE(SynthesiseLinePoints(survey, model, 8).front().p_body,
+            points.front().p_body);
 }
 
 TEST(TruthPaintProbe, PaintOnABandBareRoadBeyondTheCrossingUnknownAlone) {

@@ -10,17 +10,20 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
 
 #include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
+#include "pipeline/stages.h"
 #include "registration/band_matcher.h"
 #include "registration/match_stage.h"
 #include "registration/roadmark_index.h"
 #include "simulator/simulated_survey.h"
 #include "survey/math_util.h"
+#include "tests/support/synthetic_lines.h"
 #include "tests/support/synthetic_reconstruction.h"
 
 namespace zebrageo::support {
@@ -149,6 +152,7 @@ void ScorePoses(const sim::SimulatedSurvey& simulated, const Survey& survey,
 
 void Dump(const SimulationOptions& options,
           const SyntheticReconstruction& reconstruction,
+          const std::vector<ReconstructedLinePoint>* lines,
           const MatchResult& match, const AdjustmentResult& adjusted,
           bool usable, const std::string& folder) {
   namespace fs = std::filesystem;
@@ -162,6 +166,10 @@ void Dump(const SimulationOptions& options,
       std::to_string(options.seed)};
   WriteReconstructedBands(reconstruction.vertices, comments,
                           (results / kReconstructedBandsFile).string());
+  if (lines != nullptr) {
+    WriteReconstructedLines(*lines, comments,
+                            (results / kReconstructedLinesFile).string());
+  }
   WriteMatches(match.matches, comments, (results / kMatchesFile).string());
   WriteCrossingDecisions(match.decisions, comments,
                          (results / kCrossingDecisionsFile).string());
@@ -260,30 +268,41 @@ std::string GeometryRunResult::Line() const {
 
 // What `zebrageo run` does after its first adjustment (pipeline.cc): the
 // matches the adjustment rejected removed, the second registration pass on
-// the adjusted trajectory, and the adjustment again when it added matches.
+// the adjusted trajectory (on the road lines' alone when the adjustment had
+// too few crossings), and the adjustment again when it added matches.
 // Returns the observations it matched; *matches and *adjusted are what the
 // user gets, *rejected the vertex matches the first adjustment rejected.
 int RematchAndAdjust(const Survey& survey,
                      const SyntheticReconstruction& reconstruction,
+                     const std::vector<ReconstructedLinePoint>* lines,
+                     const std::vector<double>* line_control_times,
                      const TruthPaintProbe& probe,
-                     const AdjustmentOptions& adjustment,
-                     AdjustmentInput* adjust_input,
-                     std::vector<VertexMatch>* matches,
+                     const AdjustmentOptions& adjustment, AdjustmentData* data,
                      std::vector<CrossingDecision> decisions,
                      AdjustmentResult* adjusted, int* rejected) {
   std::string rejected_crossings;
-  *rejected = RemoveRejectedMatches(*adjusted, matches, &decisions,
+  *rejected = RemoveRejectedMatches(*adjusted, &data->matches, &decisions,
                                     &rejected_crossings);
-  AdjustmentRecord record;
-  record.posterior_sd_computed = adjusted->summary.covariance_computed;
-  record.counts.control_crossings = adjusted->summary.num_control_crossings;
-  record.counts.check_crossings = adjusted->summary.num_check_crossings;
+  AdjustmentRecord record =
+      AdjustmentRecordOf(*data, adjustment, *adjusted, nullptr);
   RematchInput first;
   first.vertices = &reconstruction.vertices;
-  first.matches = matches;
+  first.matches = &data->matches;
   first.decisions = &decisions;
   first.adjusted_trajectory = &adjusted->corrected_samples;
   first.adjustment = &record;
+  first.line_control_times = line_control_times;
+  std::optional<RoadLinesAdjustment> on_lines;
+  if (SecondPassOnRoadLines(record, decisions, lines != nullptr)) {
+    AdjustmentData without_matches = *data;
+    without_matches.matches.clear();
+    on_lines = AdjustByRoadLinesAlone(without_matches, lines, adjustment);
+    if (on_lines) {
+      first.adjustment = &on_lines->record;
+      first.adjusted_trajectory = &on_lines->trajectory;
+      first.line_control_times = &on_lines->line_control_times;
+    }
+  }
   first.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
                                const BandCornersEnu& band,
                                const std::vector<BandCornersEnu>& seen) {
@@ -292,9 +311,10 @@ int RematchAndAdjust(const Survey& survey,
   RematchSummary rematch = RematchWithAdjustedTrajectory(
       survey, first, MatchOptions(), RematchOptions());
   if (rematch.added == 0) return 0;
-  *matches = std::move(rematch.matches);
-  adjust_input->matches = matches;
-  *adjusted = AdjustTrajectory(adjustment, *adjust_input);
+  data->matches = std::move(rematch.matches);
+  std::vector<std::string> warnings;
+  *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
+                                  &warnings, nullptr, nullptr);
   return rematch.added;
 }
 
@@ -360,24 +380,30 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
       }
     }
 
+    std::vector<ReconstructedLinePoint> line_points;
+    if (options.lines) {
+      line_points = SynthesiseLinePoints(simulated, model, seed);
+    }
+    const std::vector<ReconstructedLinePoint>* lines =
+        options.lines ? &line_points : nullptr;
+    result.line_points = static_cast<int>(line_points.size());
     AdjustmentOptions adjustment;
     adjustment.solver.num_threads = 1;
-    AdjustmentInput adjust_input;
-    adjust_input.rig = &survey.rig;
-    adjust_input.frame = &survey.frame;
-    adjust_input.trajectory = &survey.trajectory;
-    adjust_input.exposures = &survey.exposures;
-    adjust_input.roadmarks = &survey.roadmarks;
-    adjust_input.vertices = &reconstruction.vertices;
-    adjust_input.matches = &match.matches;
-    AdjustmentResult adjusted = AdjustTrajectory(adjustment, adjust_input);
-    std::vector<VertexMatch> matches = match.matches;
+    adjustment.log_warnings = false;
+    AdjustmentData data =
+        AdjustmentDataOf(survey, reconstruction.vertices, match.matches);
+    std::vector<std::string> warnings;
+    std::vector<double> line_control_times;
+    AdjustmentResult adjusted =
+        AdjustWithRoadLines(data, data.Input(), adjustment, lines, "",
+                            &warnings, nullptr, &line_control_times);
     int rejected_first = 0;
     if (options.rematch && adjusted.summary.IsUsable()) {
       result.rematched = RematchAndAdjust(
-          survey, reconstruction, probe, adjustment, &adjust_input, &matches,
-          match.decisions, &adjusted, &rejected_first);
+          survey, reconstruction, lines, &line_control_times, probe, adjustment,
+          &data, match.decisions, &adjusted, &rejected_first);
     }
+    const std::vector<VertexMatch>& matches = data.matches;
     // Scored as the user gets them: matches.csv keeps only the vertices
     // that became control (RemoveRejectedMatches).
     const std::vector<VertexMatch> kept =
@@ -398,7 +424,7 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
           result.att_before_deg + options.worse_attitude_deg;
     }
     if (!dump_folder.empty()) {
-      Dump(simulation, reconstruction, match, adjusted, result.usable,
+      Dump(simulation, reconstruction, lines, match, adjusted, result.usable,
            dump_folder);
     }
   } catch (const std::exception& e) {

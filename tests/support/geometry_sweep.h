@@ -5,8 +5,9 @@
 // For each seed: the random preset's options (simulator.h, ApplyPreset
 // "random"), the survey in memory (simulated_survey.h, no images), a
 // synthetic reconstruction and paint probe (synthetic_reconstruction.h),
-// then BuildObservations + MatchBands and AdjustTrajectory with zebra
-// control only (no tie points, no road lines), single-threaded.
+// and road-line points (synthetic_lines.h), then BuildObservations +
+// MatchBands and the adjustment with zebra crossings and road lines as
+// `zebrageo run` does (no tie points), single-threaded.
 //
 // Scoring (score_results.py, modes match and poses):
 //  - a matched vertex is right when its position placed with the TRUE pose
@@ -53,6 +54,12 @@ struct GeometrySweepOptions {
   // with the adjusted trajectory, and the adjustment again if that added
   // matches. false: match, then adjust once.
   bool rematch = true;
+  // Road lines as `zebrageo run` uses them (pipeline/stages.h): the lane
+  // lines' points synthesised (synthetic_lines.h), control in the
+  // adjustment, and the trajectory they alone correct searched by the
+  // second pass when the adjustment had too few crossings. false: zebra
+  // crossings only.
+  bool lines = true;
 
   std::string Check() const;
 };
@@ -65,6 +72,7 @@ struct GeometryRunResult {
   std::string error;     // an exception escaped (a bug)
   // Reconstruction.
   int bands_reconstructed = 0;
+  int line_points = 0;  // synthesised road-line points
   // Matching.
   // Of the matches kept as control (the adjustment's rejects removed).
   int wrong = 0;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "simulator/noise.h"
+#include "tests/support/synthetic_view_internal.h"
 
 namespace zebrageo::support {
 namespace {
@@ -48,36 +49,6 @@ std::array<std::array<int, 2>, 2> BandEnds(
   const double e12 = (q[2] - q[1]).norm() + (q[0] - q[3]).norm();
   if (e01 < e12) return {{{0, 1}, {2, 3}}};
   return {{{1, 2}, {3, 0}}};
-}
-
-// Probability of reconstructing a band in full view at `range_m`.
-double Recall(const ReconstructionModel& m, double range_m) {
-  if (range_m <= m.near_range_m) return m.near_recall;
-  if (range_m >= m.far_range_m) return m.far_recall;
-  const double u =
-      (range_m - m.near_range_m) / (m.far_range_m - m.near_range_m);
-  return m.near_recall + u * (m.far_recall - m.near_recall);
-}
-
-struct CameraView {
-  Eigen::Isometry3d T_cam_enu;
-  Eigen::Vector3d centre_enu;
-  const Camera* camera;
-};
-
-CameraView ViewOf(const Rig& rig, int camera, const Pose& pose) {
-  const Eigen::Isometry3d T_enu_cam =
-      pose.T_enu_body() * rig.cameras[camera].T_body_cam;
-  return {T_enu_cam.inverse(), T_enu_cam.translation(),
-          &rig.cameras[camera].camera};
-}
-
-bool ProjectInside(const CameraView& view, const Eigen::Vector3d& p_enu,
-                   double min_depth_m, double margin_px, Eigen::Vector2d* uv) {
-  const Eigen::Vector3d p_cam = view.T_cam_enu * p_enu;
-  if (p_cam.z() < min_depth_m) return false;
-  return view.camera->Project(p_cam, uv) &&
-         view.camera->IsInImage(*uv, margin_px);
 }
 
 // How the vehicles hide a band from a stereo pair: 0 nothing, 1 one end
@@ -133,6 +104,13 @@ ReconstructionModel ReconstructionModel::Random(uint64_t seed) {
   m.hidden_end_probability = Uniform(&rng, 0.0, 0.04);
   m.probe_unknown_share = Uniform(&rng, 0.0, 0.3);
   return m;
+}
+
+double ReconstructionModel::RecallAt(double range_m) const {
+  if (range_m <= near_range_m) return near_recall;
+  if (range_m >= far_range_m) return far_recall;
+  const double u = (range_m - near_range_m) / (far_range_m - near_range_m);
+  return near_recall + u * (far_recall - near_recall);
 }
 
 std::string ReconstructionModel::Check() const {
@@ -381,7 +359,7 @@ SyntheticReconstruction SynthesiseReconstruction(
         const int occlusion =
             Occlusion(world, view.corners, left, right, &hidden_end);
         if (occlusion != 0) ++out.views_hidden;
-        if (occlusion == 2 || draws.recall >= Recall(model, view.range_m)) {
+        if (occlusion == 2 || draws.recall >= model.RecallAt(view.range_m)) {
           continue;
         }
         bool inferred = occlusion == 1;

@@ -79,6 +79,8 @@ struct ReconstructionModel {
   // A model drawn for one survey: far_recall in [0.2, 0.9], noise,
   // faults and probe dropouts at random (deterministic in `seed`).
   static ReconstructionModel Random(uint64_t seed);
+  // Probability of reconstructing a band in full view at `range_m`.
+  double RecallAt(double range_m) const;
   // "" or "field = value: must be ...".
   std::string Check() const;
   // The drawn values in short, for a sweep's log line.
