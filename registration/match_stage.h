@@ -93,14 +93,14 @@ struct RematchOptions {
   // After an adjustment by road lines alone: the cross-track gate
   // (MatchOptions::max_cross_track_m), under half a band period...
   double cross_track_gate_m = 0.3;
-  // ... where the lines measured it: only observations within this time of
-  // a line point that held the cross-track position are searched.
-  // Between such points the position is interpolated, and a GNSS/INS
-  // error switching by a metre there (multipath) would put a crossing a
-  // band off. At a metre per 40 m (MatchOptions::max_drift_per_metre) and
-  // 12 m/s, a second moves it 0.3 m: with the 0.3 m gate, a band offset
-  // (1 m) stays out. (Geometry sweep 1-500: 2 s let 8 wrong matches in.)
-  double max_line_control_gap_s = 1.0;
+  // ... where the lines measured it: only observations within this
+  // distance travelled of a line point that held the cross-track position
+  // are searched. Between such points the position is interpolated, and a
+  // GNSS/INS error switching by a metre or more there (multipath: 1.5 m
+  // over 40 m) would put a crossing a band off once it is 0.7 m wrong
+  // (1 m less the gate). 12 m keeps it under 0.45 m. (Geometry sweep
+  // 1-500 with a gap in time: 1 and 1.5 s clean, 2 s let 8 wrong in.)
+  double max_line_control_gap_m = 12.0;
   std::string Check() const;
 };
 struct RematchSummary {

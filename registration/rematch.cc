@@ -34,10 +34,10 @@ std::string RematchOptions::Check() const {
     return "cross_track_gate_m = " + std::to_string(cross_track_gate_m) +
            ": must be in (0, 0.5)";
   }
-  if (!(max_line_control_gap_s >= 0.0) ||
-      !std::isfinite(max_line_control_gap_s)) {
-    return "max_line_control_gap_s = " +
-           std::to_string(max_line_control_gap_s) + ": must be finite and >= 0";
+  if (!(max_line_control_gap_m >= 0.0) ||
+      !std::isfinite(max_line_control_gap_m)) {
+    return "max_line_control_gap_m = " +
+           std::to_string(max_line_control_gap_m) + ": must be finite and >= 0";
   }
   if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
     return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
@@ -75,10 +75,21 @@ std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
   return "";
 }
 
-// Whether `sorted` holds a value within `gap` of `t`.
-bool NearAny(const std::vector<double>& sorted, double t, double gap) {
-  const auto it = std::lower_bound(sorted.begin(), sorted.end(), t - gap);
-  return it != sorted.end() && *it <= t + gap;
+// Whether the vehicle travelled at most `gap_m` (horizontally, on
+// `trajectory`) between time `t` and one of the `sorted` times.
+bool NearAny(const std::vector<double>& sorted, double t,
+             const Trajectory& trajectory, double gap_m) {
+  Pose at;
+  if (!trajectory.InterpolatePose(t, &at)) return false;
+  const auto after = std::lower_bound(sorted.begin(), sorted.end(), t);
+  for (auto it : {after, after == sorted.begin() ? sorted.end() : after - 1}) {
+    Pose pose;
+    if (it != sorted.end() && trajectory.InterpolatePose(*it, &pose) &&
+        (pose.p_enu - at.p_enu).head<2>().norm() <= gap_m) {
+      return true;
+    }
+  }
+  return false;
 }
 
 // The second pass: the bands matched again on the survey as the adjustment
@@ -116,8 +127,8 @@ MatchResult MatchOnAdjustedTrajectory(
     input.observations.erase(
         std::remove_if(input.observations.begin(), input.observations.end(),
                        [&](const CrossingObservation& o) {
-                         return !NearAny(times, o.time_s,
-                                         rematch.max_line_control_gap_s);
+                         return !NearAny(times, o.time_s, adjusted.trajectory,
+                                         rematch.max_line_control_gap_m);
                        }),
         input.observations.end());
     // Road lines corrected the trajectory across the track and in height:

@@ -403,8 +403,8 @@ TEST(RematchOptions, CrossTrackGateUnderHalfABand) {
   options.cross_track_gate_m = 0.5;
   EXPECT_NE(options.Check().find("cross_track_gate_m"), std::string::npos);
   options = RematchOptions();
-  options.max_line_control_gap_s = -1.0;
-  EXPECT_NE(options.Check().find("max_line_control_gap_s"), std::string::npos);
+  options.max_line_control_gap_m = -1.0;
+  EXPECT_NE(options.Check().find("max_line_control_gap_m"), std::string::npos);
   MatchOptions match;
   match.max_cross_track_m = -1.0;
   EXPECT_NE(match.Check().find("max_cross_track_m"), std::string::npos);
