@@ -118,55 +118,48 @@ std::vector<ReconstructedLinePoint> SynthesiseLinePoints(
     uint64_t seed, const LineSynthesisOptions& options) {
   std::mt19937_64 rng(sim::SubSeed(seed, kLineSeed));
   const sim::World& world = survey.world;
-  const Rig& rig = survey.rig;
   const std::vector<PaintedLine> lines = PaintedLines(world, options.spacing_m);
-  const std::map<int64_t, Pose> true_pose = TruePoses(survey);
   std::vector<ReconstructedLinePoint> points;
   int64_t next_line_id = 1;
-  for (const Exposure& exposure : survey.exposures.exposures) {
-    const auto pose_it = true_pose.find(exposure.exposure_id);
-    if (pose_it == true_pose.end()) continue;
-    const Pose& pose = pose_it->second;
-    const Eigen::Isometry3d T_body_enu = pose.T_enu_body().inverse();
-    for (int pair = 0; pair < static_cast<int>(rig.stereo_pairs.size());
-         ++pair) {
-      const CameraView left = ViewOf(rig, rig.stereo_pairs[pair][0], pose);
-      const CameraView right = ViewOf(rig, rig.stereo_pairs[pair][1], pose);
-      for (const PaintedLine& line : lines) {
-        // Runs of consecutive points seen: a vehicle hiding the middle of
-        // a line splits it in two.
-        std::vector<std::vector<int>> runs(1);
-        std::vector<std::vector<std::array<Eigen::Vector2d, 2>>> uvs(1);
-        for (int j = 0; j < static_cast<int>(line.points.size()); ++j) {
-          Eigen::Vector2d uv[2];
-          if (Seen(world, model, options, pose, left, right, line.points[j],
-                   uv)) {
-            runs.back().push_back(j);
-            uvs.back().push_back({uv[0], uv[1]});
-          } else if (!runs.back().empty()) {
-            runs.emplace_back();
-            uvs.emplace_back();
+  ForEachStereoView(
+      survey, TruePoses(survey),
+      [&](const Exposure& exposure, int pair, const Pose& pose,
+          const Eigen::Isometry3d& T_body_enu, const CameraView& left,
+          const CameraView& right) {
+        for (const PaintedLine& line : lines) {
+          // Runs of consecutive points seen: a vehicle hiding the middle of
+          // a line splits it in two.
+          std::vector<std::vector<int>> runs(1);
+          std::vector<std::vector<std::array<Eigen::Vector2d, 2>>> uvs(1);
+          for (int j = 0; j < static_cast<int>(line.points.size()); ++j) {
+            Eigen::Vector2d uv[2];
+            if (Seen(world, model, options, pose, left, right, line.points[j],
+                     uv)) {
+              runs.back().push_back(j);
+              uvs.back().push_back({uv[0], uv[1]});
+            } else if (!runs.back().empty()) {
+              runs.emplace_back();
+              uvs.emplace_back();
+            }
+          }
+          for (size_t r = 0; r < runs.size(); ++r) {
+            const std::vector<int>& run = runs[r];
+            if (static_cast<int>(run.size()) < options.min_points) continue;
+            const double recall = sim::Uniform(&rng, 0.0, 1.0);
+            const Eigen::Vector3d middle = line.points[run[run.size() / 2]];
+            if (recall >= model.RecallAt((middle - left.centre_enu).norm())) {
+              continue;
+            }
+            ReconstructedLinePoint base;
+            base.exposure_id = exposure.exposure_id;
+            base.pair = pair;
+            base.line_id = next_line_id++;
+            base.type = line.type;
+            AppendLine(model, line, run, uvs[r], left, T_body_enu, base, &rng,
+                       &points);
           }
         }
-        for (size_t r = 0; r < runs.size(); ++r) {
-          const std::vector<int>& run = runs[r];
-          if (static_cast<int>(run.size()) < options.min_points) continue;
-          const double recall = sim::Uniform(&rng, 0.0, 1.0);
-          const Eigen::Vector3d middle = line.points[run[run.size() / 2]];
-          if (recall >= model.RecallAt((middle - left.centre_enu).norm())) {
-            continue;
-          }
-          ReconstructedLinePoint base;
-          base.exposure_id = exposure.exposure_id;
-          base.pair = pair;
-          base.line_id = next_line_id++;
-          base.type = line.type;
-          AppendLine(model, line, run, uvs[r], left, T_body_enu, base, &rng,
-                     &points);
-        }
-      }
-    }
-  }
+      });
   return points;
 }
 

@@ -333,67 +333,62 @@ SyntheticReconstruction SynthesiseReconstruction(
     uint64_t seed) {
   std::mt19937_64 rng(sim::SubSeed(seed, kReconstructionSeed));
   const sim::World& world = survey.world;
-  const Rig& rig = survey.rig;
-  const std::map<int64_t, Pose> true_pose = TruePoses(survey);
   SyntheticReconstruction out;
   int64_t next_band_id = 1;
   int64_t next_group_id = 1;
-  for (const Exposure& exposure : survey.exposures.exposures) {
-    const auto pose_it = true_pose.find(exposure.exposure_id);
-    if (pose_it == true_pose.end()) continue;
-    const Pose& pose = pose_it->second;
-    const Eigen::Isometry3d T_body_enu = pose.T_enu_body().inverse();
-    for (int pair = 0; pair < static_cast<int>(rig.stereo_pairs.size());
-         ++pair) {
-      const CameraView left = ViewOf(rig, rig.stereo_pairs[pair][0], pose);
-      const CameraView right = ViewOf(rig, rig.stereo_pairs[pair][1], pose);
-      std::map<int, int64_t> group_of_crossing;
-      for (int b = 0; b < static_cast<int>(world.bands.size()); ++b) {
-        const sim::Band& band = world.bands[b];
-        BandView view;
-        view.band = b;
-        if (!SeeWhole(model, band, left, right, &view)) continue;
-        ++out.views_in_range;
-        const ViewDraws draws = Draw(&rng);
-        int hidden_end = -1;
-        const int occlusion =
-            Occlusion(world, view.corners, left, right, &hidden_end);
-        if (occlusion != 0) ++out.views_hidden;
-        if (occlusion == 2 || draws.recall >= model.RecallAt(view.range_m)) {
-          continue;
+  ForEachStereoView(
+      survey, TruePoses(survey),
+      [&](const Exposure& exposure, int pair, const Pose&,
+          const Eigen::Isometry3d& T_body_enu, const CameraView& left,
+          const CameraView& right) {
+        std::map<int, int64_t> group_of_crossing;
+        for (int b = 0; b < static_cast<int>(world.bands.size()); ++b) {
+          const sim::Band& band = world.bands[b];
+          BandView view;
+          view.band = b;
+          if (!SeeWhole(model, band, left, right, &view)) continue;
+          ++out.views_in_range;
+          const ViewDraws draws = Draw(&rng);
+          int hidden_end = -1;
+          const int occlusion =
+              Occlusion(world, view.corners, left, right, &hidden_end);
+          if (occlusion != 0) ++out.views_hidden;
+          if (occlusion == 2 || draws.recall >= model.RecallAt(view.range_m)) {
+            continue;
+          }
+          bool inferred = occlusion == 1;
+          bool cut_short = false;
+          if (!inferred && draws.fault < model.hidden_end_probability) {
+            inferred = true;
+            hidden_end = draws.end;
+          } else if (!inferred &&
+                     draws.fault < model.hidden_end_probability +
+                                       model.cut_short_probability) {
+            cut_short = CutShort(left, right, draws.end, draws.cut_m, &view);
+          }
+          // The real stage infers an end from the crossing's other bands, and
+          // not far away.
+          if (inferred &&
+              (world.crossings[band.crossing].num_street_bands < 4 ||
+               view.range_m > model.max_inferred_range_m)) {
+            continue;
+          }
+          ++out.views_reconstructed;
+          auto [group_it, added] =
+              group_of_crossing.emplace(band.crossing, next_group_id);
+          if (added) ++next_group_id;
+          ReconstructedVertex base;
+          base.exposure_id = exposure.exposure_id;
+          base.pair = pair;
+          base.band_id = next_band_id++;
+          base.group_id = group_it->second;
+          out.truth_of_band[base.band_id] = {b, view.range_m, cut_short,
+                                             inferred};
+          AppendVertices(model, view, left, T_body_enu,
+                         inferred ? hidden_end : -1, draws.ring_shift, base,
+                         &rng, &out.vertices);
         }
-        bool inferred = occlusion == 1;
-        bool cut_short = false;
-        if (!inferred && draws.fault < model.hidden_end_probability) {
-          inferred = true;
-          hidden_end = draws.end;
-        } else if (!inferred && draws.fault < model.hidden_end_probability +
-                                                  model.cut_short_probability) {
-          cut_short = CutShort(left, right, draws.end, draws.cut_m, &view);
-        }
-        // The real stage infers an end from the crossing's other bands, and
-        // not far away.
-        if (inferred && (world.crossings[band.crossing].num_street_bands < 4 ||
-                         view.range_m > model.max_inferred_range_m)) {
-          continue;
-        }
-        ++out.views_reconstructed;
-        auto [group_it, added] =
-            group_of_crossing.emplace(band.crossing, next_group_id);
-        if (added) ++next_group_id;
-        ReconstructedVertex base;
-        base.exposure_id = exposure.exposure_id;
-        base.pair = pair;
-        base.band_id = next_band_id++;
-        base.group_id = group_it->second;
-        out.truth_of_band[base.band_id] = {b, view.range_m, cut_short,
-                                           inferred};
-        AppendVertices(model, view, left, T_body_enu,
-                       inferred ? hidden_end : -1, draws.ring_shift, base, &rng,
-                       &out.vertices);
-      }
-    }
-  }
+      });
   return out;
 }
 
