@@ -28,11 +28,7 @@ struct Context {
   AdjustmentSummary* summary;
 
   void Warn(const std::string& warning) const {
-    if (options.log_warnings) {
-      LOG(WARNING) << warning;
-    } else {
-      VLOG(1) << warning;
-    }
+    LogAdjustmentWarning(options, warning);
     summary->warnings.push_back(warning);
   }
   bool InsPoseAt(double time, Pose* pose) const {

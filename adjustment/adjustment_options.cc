@@ -1,3 +1,5 @@
+#include <glog/logging.h>
+
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -26,6 +28,15 @@ const char* ControlStatusName(ControlStatus status) {
       return "rejected";
   }
   return "?";
+}
+
+void LogAdjustmentWarning(const AdjustmentOptions& options,
+                          const std::string& warning) {
+  if (options.log_warnings) {
+    LOG(WARNING) << warning;
+  } else {
+    VLOG(1) << warning;
+  }
 }
 
 std::string AdjustmentOptions::Check() const {

@@ -409,6 +409,10 @@ struct AdjustmentResult {
   std::vector<TieTrack> tie_tracks;
 };
 
+// Logs `warning` as log_warnings says (a warning, or VLOG(1)).
+void LogAdjustmentWarning(const AdjustmentOptions& options,
+                          const std::string& warning);
+
 // Runs the adjustment. Never throws on bad data and never returns NaN
 // poses: a failed solve gives summary.usable = false and the reason in
 // summary.message. Without any usable control the input trajectory is

@@ -145,11 +145,7 @@ bool UpdateVarianceComponents(const AdjustmentOptions& options,
           " deg (robust RMS) where the vehicle's sideslip is a tenth of a "
           "degree: its positions are too noisy for the vehicle-motion "
           "constraint, which is not used";
-      if (options.log_warnings) {
-        LOG(WARNING) << warning;
-      } else {
-        VLOG(1) << warning;
-      }
+      LogAdjustmentWarning(options, warning);
       warnings->push_back(warning);
       state->motion.clear();
       changed = true;

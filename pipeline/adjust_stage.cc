@@ -170,23 +170,18 @@ std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
   AdjustmentInput input = data.Input();
   const std::vector<VertexMatch> no_matches;
   input.matches = &no_matches;
-  // Without control the adjustment keeps the input trajectory; the lines
-  // are then placed by the cross-track offsets they agree on.
-  const AdjustmentResult uncorrected = AdjustTrajectory(options, input);
-  if (!uncorrected.summary.IsUsable()) return std::nullopt;
+  // Without control the first adjustment keeps the input trajectory; the
+  // lines are then placed by the cross-track offsets they agree on.
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data, options, uncorrected, line_points, "", &warnings);
-  if (control.empty()) return std::nullopt;
-  input.line_points = &control;
-  AdjustmentResult result = AdjustTrajectory(options, input);
+  RoadLinesAdjustment out;
+  AdjustmentResult result =
+      AdjustWithRoadLines(data, input, options, line_points, "", &warnings,
+                          nullptr, &out.line_control_times);
   if (!result.summary.IsUsable() || !result.summary.line_control_only) {
     return std::nullopt;
   }
-  RoadLinesAdjustment out;
   out.record = AdjustmentRecordOf(data, options, result, nullptr);
   out.trajectory = std::move(result.corrected_samples);
-  out.line_control_times = CrossTrackTimes(control);
   return out;
 }
 

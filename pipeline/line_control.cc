@@ -172,7 +172,8 @@ void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
 // warning is listed once in report.json) and lists it in `summary`.
 void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
                        const std::vector<DatabaseLineEnu>& database,
-                       bool log_warnings, LineControlRecord* summary,
+                       const AdjustmentOptions& options,
+                       LineControlRecord* summary,
                        std::vector<std::string>* warnings) {
   for (const RejectedLine& r : rejected) {
     const DatabaseLineEnu& line = database[r.db_line];
@@ -181,11 +182,7 @@ void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
       << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
       << " m across from where the other lines put it: repainted or stale, "
          "not used as control";
-    if (log_warnings) {
-      LOG(WARNING) << w.str();
-    } else {
-      VLOG(1) << w.str();
-    }
+    LogAdjustmentWarning(options, w.str());
     warnings->push_back(w.str());
     summary->rejected_lines.push_back(
         {line.id, line.type, r.points, r.offset_m});
@@ -300,8 +297,7 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     }
   }
   LineControlRecord summary;
-  WarnRejectedLines(rejected, database, options.log_warnings, &summary,
-                    warnings);
+  WarnRejectedLines(rejected, database, options, &summary, warnings);
 
   std::vector<LineMatch> rows;
   // Per 30 s stretch: matches, and the directions controlled.
