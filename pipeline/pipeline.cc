@@ -3,7 +3,6 @@
 #include <glog/logging.h>
 #include <sys/resource.h>
 
-#include <filesystem>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -88,11 +87,7 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
   std::vector<double> line_times;
   if (first.adjustment != nullptr && first.adjustment->road_lines_only &&
       options.lines) {
-    const std::string path = results->folder() + "/" + kLineMatchesFile;
-    if (std::filesystem::exists(path)) {
-      line_times = LineControlTimes(ReadLineMatches(path, kLineMatchesFile),
-                                    survey.exposures);
-    }
+    line_times = LineControlTimesIn(results->folder(), survey.exposures);
   }
   first.line_control_times = &line_times;
   std::optional<RoadLinesAdjustment> lines;

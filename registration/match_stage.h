@@ -134,6 +134,9 @@ struct RematchInput {
 // the position across their line, sorted.
 std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
                                      const ExposureTable& exposures);
+// The same from results_folder's line_matches.csv; empty without it.
+std::vector<double> LineControlTimesIn(const std::string& results_folder,
+                                       const ExposureTable& exposures);
 // Writes nothing (WriteRematchResults does).
 RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
                                              const RematchInput& first,

@@ -283,6 +283,14 @@ std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
   return times;
 }
 
+std::vector<double> LineControlTimesIn(const std::string& results_folder,
+                                       const ExposureTable& exposures) {
+  const fs::path path = fs::path(results_folder) / kLineMatchesFile;
+  if (!fs::exists(path)) return {};
+  return LineControlTimes(ReadLineMatches(path.string(), kLineMatchesFile),
+                          exposures);
+}
+
 void WriteRematchResults(const RematchSummary& summary,
                          const std::string& results_folder) {
   if (summary.added == 0) return;
@@ -343,12 +351,8 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
   first.vertices = &vertices;
   // After road lines alone, where they held the cross-track position.
   std::vector<double> line_times;
-  const fs::path line_matches = folder / kLineMatchesFile;
-  if (undecided && first.adjustment->road_lines_only &&
-      fs::exists(line_matches)) {
-    line_times = LineControlTimes(
-        ReadLineMatches(line_matches.string(), kLineMatchesFile),
-        survey.exposures);
+  if (undecided && first.adjustment->road_lines_only) {
+    line_times = LineControlTimesIn(results_folder, survey.exposures);
   }
   first.line_control_times = &line_times;
   const RematchSummary summary =
