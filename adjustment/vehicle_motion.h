@@ -17,8 +17,10 @@
 // attitude at t:
 //   p_j   = p_ins(t_j) + F_j c(t_j)[3:6]            t_j = t - h, t, t + h
 //   b     = R_ins(t)^T Exp(-F_1 c(t)[0:3]) (p_2 - p_0)   (body FRD)
-//   r     = [(atan2(b_y, b_x) - m_yaw - m_axle curvature) / sigma_lateral,
-//            (atan2(b_z, b_x) - m_pitch) / sigma_vertical]
+//   r     = [(b_y / L - m_yaw - m_axle curvature) / sigma_lateral,
+//            (b_z / L - m_pitch) / sigma_vertical]
+// L: the INS chord's horizontal length, fixed (small angles; an along-track
+// correction stretches the chord, it does not turn it).
 // F_j: the correction's frame at t_j (TrajectoryCorrection::Frame); m: the
 // vehicle block [yaw misalignment (rad), axle offset (m), pitch
 // misalignment (rad)]. The vertical spread is larger (heave, pitching on
@@ -121,13 +123,19 @@ class VehicleMotionError {
     T v[3];
     ceres::AngleAxisRotatePoint(minus_dtheta, chord, v);
     const Eigen::Matrix3d R = sample_.ins[1].q_enu_body.toRotationMatrix();
-    const T b_x = R(0, 0) * v[0] + R(1, 0) * v[1] + R(2, 0) * v[2];
     const T b_y = R(0, 1) * v[0] + R(1, 1) * v[1] + R(2, 1) * v[2];
     const T b_z = R(0, 2) * v[0] + R(1, 2) * v[1] + R(2, 2) * v[2];
+    // Over the INS chord's length, not atan2(b_y, b_x): an along-track
+    // correction changes the chord's length, not its direction, and must
+    // not buy a smaller crab angle by stretching the chord (through a GNSS
+    // outage the fit otherwise moved the trajectory metres along-track to
+    // shrink a crab the INS's lateral drift made).
+    const double length =
+        sample_.speed_mps * (sample_.times[2] - sample_.times[0]);
     residual[0] =
-        (atan2(b_y, b_x) - vehicle[0] - vehicle[1] * sample_.curvature_per_m) /
+        (b_y / length - vehicle[0] - vehicle[1] * sample_.curvature_per_m) /
         sample_.sigma_lateral_rad;
-    residual[1] = (atan2(b_z, b_x) - vehicle[2]) / sample_.sigma_vertical_rad;
+    residual[1] = (b_z / length - vehicle[2]) / sample_.sigma_vertical_rad;
     return true;
   }
 
