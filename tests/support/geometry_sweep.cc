@@ -175,6 +175,8 @@ void Dump(const SimulationOptions& options,
                          (results / kCrossingDecisionsFile).string());
   if (usable) {
     WriteCameraPoses(adjusted.camera_poses, (results / kPosesFile).string());
+    WriteTrajectorySamples(adjusted.corrected_samples,
+                           (results / kTrajectoryCorrectedFile).string());
   }
 }
 
