@@ -101,8 +101,10 @@ struct MatchOptions {
   // half the 1 m band period, above database error + drift change.
   double hit_tolerance_m = 0.3;
   // A vertex becomes a control point only if, after the correction refined
-  // on the observation's own bands, every corner of its band lies within
-  // this of its database corner.
+  // on the observation's own bands, it lies within this of its database
+  // corner, and every corner of its band lies within this across the
+  // band's axis (the band is the database's), two of them whole. An end
+  // seen short or drawn long loses its two corners, not the band.
   double vertex_tolerance_m = 0.15;
   double missing_band_weight = 1.0;
   // Over the window, a database band that should have been seen counts as

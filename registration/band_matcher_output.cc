@@ -1,6 +1,7 @@
 // Step 5 of MatchBands (band_matcher_internal.h): each accepted
 // observation's correction refined on its own bands into vertex matches
-// (the bands whose every corner fits to vertex_tolerance_m), the database
+// (the bands whose corners lie on them across their axis, and the corners
+// that also lie at their ends, to vertex_tolerance_m), the database
 // faults the decisions reveal, and the result with a decision per
 // observation.
 #include <algorithm>
@@ -19,8 +20,9 @@ namespace band_matcher_internal {
 namespace {
 
 // The matches of accepted observation `o` after refining its correction
-// on its own bands: the bands whose every corner fits to
-// vertex_tolerance_m.
+// on its own bands: on the bands whose every corner fits across the band's
+// axis to vertex_tolerance_m, with two corners or more that fit whole, the
+// corners that fit whole.
 std::vector<VertexMatch> RefinedMatches(const MatchState& state, int o,
                                         PoseCorrection* correction,
                                         std::vector<int>* bands,
@@ -42,18 +44,30 @@ std::vector<VertexMatch> RefinedMatches(const MatchState& state, int o,
     const IndexedBand& db = index.bands()[hit.db];
     if (db.implied) continue;  // no database coordinates to control with
     const ObsBand& band = obs.bands[hit.rec];
+    // The band is the database's where every corner lies on it across its
+    // axis; a corner is matched where it also lies at its end. An end
+    // seen short (cut by the image, worn paint) or drawn long in the
+    // database is left out alone, not the band with it.
+    const Eigen::Vector2d across_axis(-db.axis_enu.y(), db.axis_enu.x());
     std::array<double, 4> error;
-    bool fits = true;
+    std::array<bool, 4> corner_fits;
+    bool across_fits = true;
+    int corners = 0;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector2d p = Apply(c, obs.vehicle, band.q[k]);
-      error[k] =
-          (p - db.corners_enu[PermutedCorner(hit.perm, k)].head<2>()).norm();
-      fits = fits && error[k] <= options.vertex_tolerance_m;
+      const Eigen::Vector2d e =
+          p - db.corners_enu[PermutedCorner(hit.perm, k)].head<2>();
+      error[k] = e.norm();
+      across_fits = across_fits &&
+                    std::abs(e.dot(across_axis)) <= options.vertex_tolerance_m;
+      corner_fits[k] = error[k] <= options.vertex_tolerance_m;
+      corners += corner_fits[k] ? 1 : 0;
     }
-    if (!fits) continue;
+    if (!across_fits || corners < 2) continue;
     bands->push_back(db.band);
     const ObservedBand& source = obs.source->bands[hit.rec];
     for (int k = 0; k < 4; ++k) {
+      if (!corner_fits[k]) continue;
       VertexMatch match;
       match.exposure_id = obs.source->exposure_id;
       match.band_id = source.band_id;
