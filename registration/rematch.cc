@@ -183,6 +183,10 @@ std::vector<CrossingDecision> MergeSecondPass(
           return s.exposure_id == d.exposure_id && s.group_id == d.group_id;
         });
     if (it == second.decisions.end() || it->decision != Decision::kMatched) {
+      if (it != second.decisions.end()) {
+        VLOG(1) << "second pass: exposure " << d.exposure_id << " group "
+                << d.group_id << " still undecided: " << it->reason;
+      }
       continue;
     }
     const auto bands = bands_of.find({d.exposure_id, d.group_id});
