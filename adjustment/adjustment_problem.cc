@@ -184,7 +184,16 @@ void AdjustmentProblem::AddKnotPriors() {
   for (int k = 0; k < n; ++k) {
     for (int part = 0; part < 2; ++part) {
       const int offset = 3 * part;
-      const Eigen::Vector3d s = sigma.segment<3>(offset);
+      Eigen::Vector3d s = sigma.segment<3>(offset);
+      if (part == 1 && k > 0 && !state_->knot_extra_variance_m2.empty()) {
+        // A jump that stays a step, an outage's closure: the innovation's
+        // variance grows by what the error gains over this step.
+        for (int i = 0; i < 3; ++i) {
+          s[i] = std::sqrt(s[i] * s[i] +
+                           state_->knot_extra_variance_m2[k] /
+                               std::max(1e-12, 1.0 - phi[3 + i] * phi[3 + i]));
+        }
+      }
       // No robust loss on the process: with a small sigma a robust loss
       // makes a metre-size single-knot spike cheap, and the GNSS jumps it
       // would be for are taken out of the trajectory beforehand

@@ -139,6 +139,7 @@ void InitialiseCorrection(const Context& context, State* state) {
                                 std::array<double, kRigCorrectionSize>{});
   context.summary->num_knots = state->correction.num_knots();
   if (context.dejumped.num_jumps > 0) {
+    int previous_sample = 0;
     for (int k = 0; k < state->correction.num_knots(); ++k) {
       const double t =
           std::clamp(state->correction.KnotTime(k), trajectory.start_time(),
@@ -148,11 +149,20 @@ void InitialiseCorrection(const Context& context, State* state) {
       context.InsPoseAt(t, &pose);
       const Eigen::Matrix3d R_track_enu =
           state->correction.Frame(pose).transpose();
-      const Eigen::AngleAxisd rotation(context.dejumped.rotation_offset[i]);
+      const Eigen::AngleAxisd rotation(
+          context.dejumped.prior_rotation_offset[i]);
       Eigen::Matrix<double, 6, 1> b;
       b.head<3>() = R_track_enu * (rotation.angle() * rotation.axis());
-      b.tail<3>() = R_track_enu * context.dejumped.position_offset[i];
+      b.tail<3>() = R_track_enu * context.dejumped.prior_position_offset[i];
       state->knot_prior.push_back(b);
+      // What the error gains beyond its process between the two knots'
+      // samples (a jump that stays a step, an outage's closure).
+      double extra = 0.0;
+      for (int j = previous_sample + 1; k > 0 && j <= i; ++j) {
+        extra += context.dejumped.innovation_variance_m2[j];
+      }
+      state->knot_extra_variance_m2.push_back(extra);
+      previous_sample = i;
     }
   }
   if (options.sideslip_sigma_rad > 0.0) {

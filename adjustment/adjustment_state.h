@@ -79,9 +79,11 @@ struct TiePoint {
 // a first-order Gauss-Markov process of standard deviation sigma and
 // correlation time tau, sampled at the knots:
 //   c_0 ~ N(b_0, sigma^2),
-//   (c_k - b_k) - phi (c_{k-1} - b_{k-1}) ~ N(0, sigma^2 (1 - phi^2)),
+//   (c_k - b_k) - phi (c_{k-1} - b_{k-1}) ~ N(0, sigma^2 (1 - phi^2) + x_k),
 //   phi = exp(-knot_spacing / tau),
-// b_k the jumps taken out of the trajectory before knot k. A correlated
+// b_k the jumps taken out of the trajectory before knot k (an outage's
+// closure spread over it), x_k what the error gains at a jump or through an
+// outage beyond the process (position only; State). A correlated
 // error is then counted as what it is: a few independent values per
 // correlation time, not one per knot.
 struct ErrorModel {
@@ -139,6 +141,11 @@ struct State {
   // Centre of the GNSS/INS prior of each knot: 0, or the jumps removed
   // from the trajectory before the knot (track frame).
   std::vector<Eigen::Matrix<double, 6, 1>> knot_prior;
+  // Variance added to the position innovation into each knot (m^2, per
+  // axis): what the error gains there beyond its process, a jump that
+  // stays a step or an outage's closure
+  // (DejumpedTrajectory::innovation_variance_m2); empty: none.
+  std::vector<double> knot_extra_variance_m2;
   ErrorModel model;
   // Attitude components of the correction (0..2 of a knot) held at their
   // prior centre, the input's attitude (attitude_significance.h).

@@ -122,9 +122,15 @@ AdjustmentResult AdjustTrajectory(
                   &summary};
   summary.num_jumps = context.dejumped.num_jumps;
   if (summary.num_jumps > 0) {
-    context.Warn(std::to_string(summary.num_jumps) +
-                 " jumps in the GNSS/INS trajectory (GNSS returning after an "
-                 "outage?): corrected as continuous INS motion");
+    context.Warn(
+        std::to_string(summary.num_jumps) +
+        " jumps in the GNSS/INS trajectory (GNSS returning after an "
+        "outage?): corrected as continuous INS motion" +
+        (context.dejumped.num_closed_outages > 0
+             ? "; " + std::to_string(context.dejumped.num_closed_outages) +
+                   " close an outage (the stated sd grew into "
+                   "them) and are spread back over it"
+             : std::string()));
   }
 
   State state;

@@ -4,6 +4,115 @@
 #include <cmath>
 
 namespace zebrageo {
+namespace {
+
+// Samples [first, last] over which the offsets change: one jump, which may
+// take a few samples.
+struct JumpEvent {
+  int first = 0;
+  int last = 0;
+};
+
+bool OffsetChanges(const DejumpedTrajectory& d, int i) {
+  return d.position_offset[i] != d.position_offset[i - 1] ||
+         d.rotation_offset[i].angularDistance(d.rotation_offset[i - 1]) > 0.0;
+}
+
+std::vector<JumpEvent> JumpEvents(const DejumpedTrajectory& d) {
+  std::vector<JumpEvent> events;
+  const int n = static_cast<int>(d.position_offset.size());
+  for (int i = 1; i < n; ++i) {
+    if (!OffsetChanges(d, i)) continue;
+    if (!events.empty() && events.back().last == i - 1) {
+      events.back().last = i;
+    } else {
+      events.push_back({i, i});
+    }
+  }
+  return events;
+}
+
+// Share of a jump's closure at each sample of [start, jump.first) (zero
+// before), from the stated variance `variance` accrued since the outage's
+// start; empty where the stated sd did not grow into the jump (at least
+// 1.2 times its value after it) and the jump stays a step. `floor` is the
+// first sample the outage may start at (the previous jump's end).
+std::vector<double> ClosureShares(const std::vector<double>& variance,
+                                  const JumpEvent& jump, int floor,
+                                  int* start) {
+  constexpr double kGrowth = 1.2;  // sd before the jump / sd after
+  const double before = variance[jump.first - 1];
+  const double after = variance[jump.last];
+  if (!(before > kGrowth * kGrowth * after) || jump.first - 1 <= floor) {
+    return {};
+  }
+  // Back to where the stated sd started growing.
+  int k = jump.first - 1;
+  while (k > floor && variance[k - 1] < variance[k]) --k;
+  const double accrued = before - variance[k];
+  if (!(accrued > 0.0)) return {};
+  *start = k;
+  std::vector<double> share;
+  for (int i = k; i < jump.first; ++i) {
+    share.push_back(
+        std::clamp((variance[i] - variance[k]) / accrued, 0.0, 1.0));
+  }
+  return share;
+}
+
+}  // namespace
+
+void SpreadOutageClosures(const Trajectory& trajectory,
+                          DejumpedTrajectory* dejumped) {
+  DejumpedTrajectory& d = *dejumped;
+  d.prior_position_offset = d.position_offset;
+  d.prior_rotation_offset = d.rotation_offset;
+  d.innovation_variance_m2.assign(d.position_offset.size(), 0.0);
+  d.num_closed_outages = 0;
+  const std::vector<TrajectorySample>& samples = trajectory.samples();
+  std::vector<double> position_variance;
+  std::vector<double> attitude_variance;
+  for (const TrajectorySample& s : samples) {
+    position_variance.push_back(s.sd_enu_m.squaredNorm());
+    attitude_variance.push_back(s.sd_attitude_rad.squaredNorm());
+  }
+  int floor = 0;
+  for (const JumpEvent& jump : JumpEvents(d)) {
+    bool closed = false;
+    int start = 0;
+    const std::vector<double> position_share =
+        ClosureShares(position_variance, jump, floor, &start);
+    const Eigen::Vector3d position_jump =
+        d.position_offset[jump.last] - d.position_offset[jump.first - 1];
+    for (size_t j = 0; j < position_share.size(); ++j) {
+      d.prior_position_offset[start + j] += position_share[j] * position_jump;
+      if (j > 0) {
+        d.innovation_variance_m2[start + j] =
+            0.25 * (position_share[j] - position_share[j - 1]) *
+            position_jump.squaredNorm();
+      }
+      closed = position_jump.norm() > 0.0;
+    }
+    if (position_share.empty()) {
+      d.innovation_variance_m2[jump.first] = position_jump.squaredNorm();
+    }
+    const std::vector<double> attitude_share =
+        ClosureShares(attitude_variance, jump, floor, &start);
+    const Eigen::Quaterniond rotation_jump =
+        d.rotation_offset[jump.last] *
+        d.rotation_offset[jump.first - 1].inverse();
+    for (size_t j = 0; j < attitude_share.size(); ++j) {
+      const Eigen::Quaterniond part = Eigen::Quaterniond::Identity().slerp(
+          attitude_share[j], rotation_jump);
+      d.prior_rotation_offset[start + j] =
+          (part * d.rotation_offset[start + j]).normalized();
+      closed = closed || rotation_jump.angularDistance(
+                             Eigen::Quaterniond::Identity()) > 0.0;
+    }
+    d.num_closed_outages += closed;
+    floor = jump.last;
+  }
+}
 
 DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
                                double threshold_rad) {
@@ -13,7 +122,10 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
   out.poses = poses;
   out.position_offset.assign(n, Eigen::Vector3d::Zero());
   out.rotation_offset.assign(n, Eigen::Quaterniond::Identity());
-  if (n < 8 || (threshold_m <= 0.0 && threshold_rad <= 0.0)) return out;
+  if (n < 8 || (threshold_m <= 0.0 && threshold_rad <= 0.0)) {
+    SpreadOutageClosures(trajectory, &out);
+    return out;
+  }
   const std::vector<TrajectorySample>& samples = trajectory.samples();
   // Steps per second (velocity, angular rate in the body frame).
   std::vector<Eigen::Vector3d> velocity(n, Eigen::Vector3d::Zero());
@@ -105,6 +217,7 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
     out.poses[i].q_enu_body =
         (rotation_jump.inverse() * poses[i].q_enu_body).normalized();
   }
+  SpreadOutageClosures(trajectory, &out);
   return out;
 }
 
