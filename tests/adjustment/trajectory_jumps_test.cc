@@ -75,14 +75,19 @@ Errors NorthErrors(const Outage& outage, const DejumpedTrajectory& d) {
   return e;
 }
 
+// The outage's trajectory, de-jumped with the adjustment's thresholds.
+DejumpedTrajectory Dejump(const Outage& outage) {
+  return RemoveJumps(Trajectory(outage.samples, outage.frame), 0.05,
+                     DegToRad(0.05));
+}
+
 // The jump at the GNSS's return closes the outage: spread back over it in
 // proportion to the stated variance, the prior's centre follows the drift
 // (quadratic here) within 10 cm where the input was 1.8 m off, and meets the
 // GNSS at both ends.
 TEST(OutageClosure, AJumpIntoAGrowingStatedSdIsSpreadBackOverTheOutage) {
   const Outage outage(true);
-  const Trajectory trajectory(outage.samples, outage.frame);
-  const DejumpedTrajectory d = RemoveJumps(trajectory, 0.05, DegToRad(0.05));
+  const DejumpedTrajectory d = Dejump(outage);
   ASSERT_EQ(d.num_jumps, 1);
   EXPECT_EQ(d.num_closed_outages, 1);
   const Errors e = NorthErrors(outage, d);
@@ -92,8 +97,8 @@ TEST(OutageClosure, AJumpIntoAGrowingStatedSdIsSpreadBackOverTheOutage) {
   // closure's square at the jump and is zero outside the outage; the jump
   // itself adds none (the spread carries it).
   double in_outage = 0.0, elsewhere = 0.0;
-  for (int i = 0; i < trajectory.size(); ++i) {
-    const double t = trajectory.samples()[i].time;
+  for (size_t i = 0; i < outage.samples.size(); ++i) {
+    const double t = outage.samples[i].time;
     (t > kOutageStart && t < kOutageEnd ? in_outage : elsewhere) +=
         d.innovation_variance_m2[i];
   }
@@ -105,11 +110,10 @@ TEST(OutageClosure, AJumpIntoAGrowingStatedSdIsSpreadBackOverTheOutage) {
 // jump stays a step, as the input has it.
 TEST(OutageClosure, AJumpWithoutGrowthOfTheStatedSdStaysAStep) {
   const Outage outage(false);
-  const Trajectory trajectory(outage.samples, outage.frame);
-  const DejumpedTrajectory d = RemoveJumps(trajectory, 0.05, DegToRad(0.05));
+  const DejumpedTrajectory d = Dejump(outage);
   ASSERT_EQ(d.num_jumps, 1);
   EXPECT_EQ(d.num_closed_outages, 0);
-  for (int i = 0; i < trajectory.size(); ++i) {
+  for (size_t i = 0; i < outage.samples.size(); ++i) {
     ASSERT_EQ(d.prior_position_offset[i], d.position_offset[i]) << i;
   }
   // The input's error steps there: its square is the innovation's.
