@@ -139,7 +139,8 @@ struct State {
   std::vector<VehicleMotionSample> motion;
   std::array<double, kVehicleSize> vehicle{};
   // Centre of the GNSS/INS prior of each knot: 0, or the jumps removed
-  // from the trajectory before the knot (track frame).
+  // from the trajectory before the knot, an outage's closure spread over
+  // it (track frame).
   std::vector<Eigen::Matrix<double, 6, 1>> knot_prior;
   // Variance added to the position innovation into each knot (m^2, per
   // axis): what the error gains there beyond its process, a jump that

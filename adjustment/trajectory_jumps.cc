@@ -91,10 +91,11 @@ void SpreadOutageClosures(const Trajectory& trajectory,
             0.25 * (position_share[j] - position_share[j - 1]) *
             position_jump.squaredNorm();
       }
-      closed = position_jump.norm() > 0.0;
     }
     if (position_share.empty()) {
       d.innovation_variance_m2[jump.first] = position_jump.squaredNorm();
+    } else {
+      closed = position_jump.norm() > 0.0;
     }
     const std::vector<double> attitude_share =
         ClosureShares(attitude_variance, jump, floor, &start);
@@ -106,6 +107,8 @@ void SpreadOutageClosures(const Trajectory& trajectory,
           attitude_share[j], rotation_jump);
       d.prior_rotation_offset[start + j] =
           (part * d.rotation_offset[start + j]).normalized();
+    }
+    if (!attitude_share.empty()) {
       closed = closed || rotation_jump.angularDistance(
                              Eigen::Quaterniond::Identity()) > 0.0;
     }
