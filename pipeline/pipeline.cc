@@ -112,7 +112,7 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
         "error model)";
   }
   WriteRematchResults(rematch, results->folder());
-  if (rematch.added > 0) {
+  if (rematch.added > 0 || rematch.dropped > 0) {
     results->SetMatches(std::move(rematch.matches),
                         std::move(rematch.decisions));
   }
@@ -121,7 +121,9 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
 
 // adjust (with road lines: line matching and a second adjustment inside
 // RunAdjustStage), then the second registration pass and, if it added
-// matches, the adjustment again.
+// or removed matches, the adjustment again (and after a removal, the
+// second pass once more).
+constexpr int kMaxRematchPasses = 2;
 std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
                                 const RunOptions& options,
                                 const ProgressListener& progress) {
@@ -134,19 +136,28 @@ std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
       survey, results, first, options.tie_points, options.lines, progress);
   if (!options.rematch) return warnings;
   // Crossings the first pass could not decide, matched again with the
-  // adjusted trajectory.
-  const RematchSummary rematch = Rematch(survey, results, options);
-  LOG(INFO) << rematch.message;
-  // Refused for contradicting the first pass: logged as a warning, so
-  // listed in report.json too.
-  if (rematch.disagreements > 0) warnings.push_back(rematch.message);
-  if (rematch.added == 0) {
-    // The rematch rewrote matches.csv: its output_crs columns again.
-    AddOutputCrs(survey, results->folder());
-    return warnings;
+  // adjusted trajectory. A pass that refused first-pass crossings it
+  // contradicts adds nothing: the adjustment without them is another
+  // trajectory, searched once more.
+  std::vector<std::string> refusals;
+  for (int pass = 0; pass < kMaxRematchPasses; ++pass) {
+    const RematchSummary rematch = Rematch(survey, results, options);
+    LOG(INFO) << rematch.message;
+    // Logged as a warning, so listed in report.json too.
+    if (rematch.disagreements > 0) refusals.push_back(rematch.message);
+    if (rematch.added == 0 && rematch.dropped == 0) {
+      // The rematch rewrote matches.csv: its output_crs columns again.
+      AddOutputCrs(survey, results->folder());
+      break;
+    }
+    const bool again = rematch.dropped > 0 && pass + 1 < kMaxRematchPasses;
+    warnings =
+        RunAdjustStage(survey, results, again ? first : options.adjustment,
+                       options.tie_points, options.lines, progress);
+    if (!again) break;
   }
-  return RunAdjustStage(survey, results, options.adjustment, options.tie_points,
-                        options.lines, progress);
+  warnings.insert(warnings.end(), refusals.begin(), refusals.end());
+  return warnings;
 }
 
 }  // namespace

@@ -75,16 +75,18 @@ MatchResult RunMatchStage(const Survey& survey,
 // candidate gate shrinks to gate_m, or sd_gate_factor times the
 // adjustment's posterior sd where that is larger, and a one-band shift is no
 // longer a candidate. An observation the first pass matched is never
-// changed; if the second pass disagrees with any of them, the adjusted
-// trajectory is not trusted and nothing is added. Nothing is done without a
-// posterior covariance (adjustment.json; the sd would be the input's
-// optimistic one) or with fewer than min_control_crossings crossings in the
-// adjustment (its GNSS/INS error model is estimated from them: without
-// them the posterior sd is not the trajectory's error), except after an
-// adjustment by road lines alone (adjustment.json's road_lines_only): its
-// error model comes from the lines, which hold the cross-track position
-// only, so the pass searches along-track and in heading as the first did,
-// and across the track within cross_track_gate_m.
+// matched otherwise; if the second pass disagrees with any of them, the
+// adjusted trajectory is not trusted and nothing is added, and the crossings of
+// the first-pass matches it contradicts are refused too (their matches removed:
+// either placement may be the wrong one; the caller adjusts again). Nothing is
+// done without a posterior covariance (adjustment.json; the sd would be the
+// input's optimistic one) or with fewer than min_control_crossings crossings in
+// the adjustment (its GNSS/INS error model is estimated from them: without them
+// the posterior sd is not the trajectory's error), except after an adjustment
+// by road lines alone (adjustment.json's road_lines_only): its error model
+// comes from the lines, which hold the cross-track position only, so the pass
+// searches along-track and in heading as the first did, and across the track
+// within cross_track_gate_m.
 struct RematchOptions {
   int min_control_crossings = 3;
   double gate_m = 0.25;
@@ -107,8 +109,10 @@ struct RematchSummary {
   int observations = 0;   // undecided after the first pass
   int added = 0;          // matched now
   int disagreements = 0;  // first-pass matches the second pass contradicts
-  std::string message;    // one line for the log and the report
-  // When added > 0: what matches.csv and crossing_decisions.csv now hold.
+  int dropped = 0;  // vertex matches removed with the crossings contradicted
+  std::string message;  // one line for the log and the report
+  // When added > 0 or dropped > 0: what matches.csv and
+  // crossing_decisions.csv now hold.
   std::vector<VertexMatch> matches;
   std::vector<CrossingDecision> decisions;
 };
@@ -142,8 +146,8 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
                                              const RematchInput& first,
                                              const MatchOptions& options,
                                              const RematchOptions& rematch);
-// When the pass added matches: matches.csv and crossing_decisions.csv
-// rewritten with them (atomically).
+// When the pass added or removed matches: matches.csv and
+// crossing_decisions.csv rewritten with them (atomically).
 void WriteRematchResults(const RematchSummary& summary,
                          const std::string& results_folder);
 // The same from the files of results_folder, and the files rewritten.

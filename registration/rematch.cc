@@ -148,9 +148,11 @@ MatchResult MatchOnAdjustedTrajectory(
   return MatchBands(input, tight);
 }
 
-// Vertex matches of the first pass that the second makes differently.
+// Vertex matches of the first pass that the second makes differently, and
+// the crossings the first pass matched them to.
 int Disagreements(const std::vector<VertexMatch>& first,
-                  const std::vector<VertexMatch>& second) {
+                  const std::vector<VertexMatch>& second,
+                  std::set<std::string>* contradicted) {
   std::map<std::tuple<int64_t, int64_t, int>, const VertexMatch*> first_match;
   for (const VertexMatch& m : first) {
     first_match[{m.exposure_id, m.band_id, m.vertex}] = &m;
@@ -162,9 +164,39 @@ int Disagreements(const std::vector<VertexMatch>& first,
         (f->second->crossing_id != m.crossing_id || f->second->band != m.band ||
          f->second->db_vertex != m.db_vertex)) {
       ++disagreements;
+      contradicted->insert(f->second->crossing_id);
     }
   }
   return disagreements;
+}
+
+// The first pass's matches and decisions without the crossings in
+// `contradicted`: their decisions refused (why), their vertex matches
+// removed (counted in summary->dropped).
+void DropContradicted(const std::set<std::string>& contradicted,
+                      std::vector<VertexMatch>* matches,
+                      std::vector<CrossingDecision>* decisions,
+                      RematchSummary* summary) {
+  const auto before = matches->size();
+  matches->erase(std::remove_if(matches->begin(), matches->end(),
+                                [&](const VertexMatch& m) {
+                                  return contradicted.count(m.crossing_id) > 0;
+                                }),
+                 matches->end());
+  summary->dropped = static_cast<int>(before - matches->size());
+  for (CrossingDecision& d : *decisions) {
+    if (d.decision != Decision::kMatched ||
+        !contradicted.count(d.crossing_id)) {
+      continue;
+    }
+    d.decision = Decision::kRefused;
+    d.reason = "refused: with the adjusted trajectory crossing " +
+               d.crossing_id +
+               " comes out at another band or vertex (second pass); neither "
+               "trusted; first pass: " +
+               d.reason;
+    d.crossing_id.clear();
+  }
 }
 
 // The first pass's decisions with the observations it left undecided and
@@ -242,25 +274,39 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
         "second registration pass failed: " + second.summary.message;
     return summary;
   }
-  // What the first pass matched must come out the same.
-  summary.disagreements = Disagreements(matches, second.matches);
+  // What the first pass matched must come out the same. Where it does not
+  // (a band offset decided at one end, where a band worn off the street
+  // fakes the bare road, and the trajectory the road lines corrected puts
+  // the crossing a period away), one of two independent placements is
+  // wrong: the crossings concerned are refused, and nothing is added (the
+  // adjusted trajectory may be the wrong one). The caller adjusts again
+  // without them and may search once more.
+  std::set<std::string> contradicted;
+  summary.disagreements = Disagreements(matches, second.matches, &contradicted);
+  std::vector<CrossingDecision> merged = *first.decisions;
   if (summary.disagreements > 0) {
-    summary.message =
-        "second registration pass not used: with the adjusted trajectory " +
-        std::to_string(summary.disagreements) +
-        " vertex matches of the first pass come out differently";
+    DropContradicted(contradicted, &matches, &merged, &summary);
+    std::ostringstream message;
+    message << "second registration pass not used: with the adjusted "
+               "trajectory "
+            << summary.disagreements
+            << " vertex matches of the first pass come out differently; "
+               "crossing(s)";
+    for (const std::string& id : contradicted) message << " " << id;
+    message << " refused (" << summary.dropped << " vertex matches removed)";
+    summary.message = message.str();
     LOG(WARNING) << summary.message;
-    return summary;
+  } else {
+    merged =
+        MergeSecondPass(*first.decisions, second, bands_of, rematch,
+                        first.adjustment->road_lines_only, &matches, &summary);
+    std::ostringstream message;
+    message << "second registration pass with the adjusted trajectory: "
+            << summary.added << " of " << summary.observations
+            << " undecided observations matched";
+    summary.message = message.str();
   }
-  std::vector<CrossingDecision> merged =
-      MergeSecondPass(*first.decisions, second, bands_of, rematch,
-                      first.adjustment->road_lines_only, &matches, &summary);
-  std::ostringstream message;
-  message << "second registration pass with the adjusted trajectory: "
-          << summary.added << " of " << summary.observations
-          << " undecided observations matched";
-  summary.message = message.str();
-  if (summary.added == 0) return summary;
+  if (summary.added == 0 && summary.dropped == 0) return summary;
   std::sort(matches.begin(), matches.end(),
             [](const VertexMatch& a, const VertexMatch& b) {
               return std::tie(a.exposure_id, a.band_id, a.vertex) <
@@ -297,7 +343,7 @@ std::vector<double> LineControlTimesIn(const std::string& results_folder,
 
 void WriteRematchResults(const RematchSummary& summary,
                          const std::string& results_folder) {
-  if (summary.added == 0) return;
+  if (summary.added == 0 && summary.dropped == 0) return;
   const std::vector<std::string> comments = {"zebrageo run: " +
                                              summary.message};
   const fs::path folder(results_folder);

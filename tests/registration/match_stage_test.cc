@@ -280,7 +280,8 @@ TEST_F(SecondPassTest, MatchesWhatTheFirstPassRefusedAndNothingWrong) {
 }
 
 // The second pass is only as good as the adjusted trajectory: one that
-// contradicts the first pass's matches (here one band off) adds nothing.
+// contradicts the first pass's matches (here one band off) adds nothing,
+// and the crossings it contradicts are refused (either may be wrong).
 TEST_F(SecondPassTest, AnAdjustedTrajectoryOneBandOffIsNotTrusted) {
   // First-pass matches on the first two crossings (the right ones, from the
   // true trajectory), the third crossing left refused.
@@ -318,7 +319,31 @@ TEST_F(SecondPassTest, AnAdjustedTrajectoryOneBandOffIsNotTrusted) {
       survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
   EXPECT_GT(summary.disagreements, 0) << summary.message;
   EXPECT_EQ(summary.added, 0);
-  EXPECT_EQ(Matches().size(), before.size());
+  const std::vector<VertexMatch> after = Matches();
+  EXPECT_EQ(static_cast<int>(before.size() - after.size()), summary.dropped);
+  EXPECT_GT(summary.dropped, 0);
+  // Every observation of a contradicted crossing refused; what remains is
+  // another crossing's, and right.
+  const std::vector<CrossingDecision> now =
+      ReadCrossingDecisions(decisions_path, "decisions");
+  ASSERT_EQ(now.size(), decisions.size());
+  std::set<std::string> contradicted;
+  for (size_t k = 0; k < now.size(); ++k) {
+    if (now[k].reason.find("comes out at another band") != std::string::npos) {
+      EXPECT_EQ(now[k].decision, Decision::kRefused);
+      contradicted.insert(decisions[k].crossing_id);
+    }
+  }
+  EXPECT_FALSE(contradicted.empty());
+  for (size_t k = 0; k < now.size(); ++k) {
+    if (contradicted.count(decisions[k].crossing_id)) {
+      EXPECT_NE(now[k].decision, Decision::kMatched);
+    }
+  }
+  for (const VertexMatch& m : after) {
+    EXPECT_EQ(contradicted.count(m.crossing_id), 0u) << m.crossing_id;
+  }
+  EXPECT_EQ(ScoreMatches(scene_, after).wrong, 0);
 }
 
 TEST_F(SecondPassTest, WithoutAPosteriorSdNothingIsDone) {

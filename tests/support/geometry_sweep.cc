@@ -268,34 +268,32 @@ std::string GeometryRunResult::Line() const {
   return out.str();
 }
 
-// What `zebrageo run` does after its first adjustment (pipeline.cc): the
-// matches the adjustment rejected removed, the second registration pass on
-// the adjusted trajectory (on the road lines' alone when the adjustment had
-// too few crossings), and the adjustment again when it added matches.
-// Returns the observations it matched; *matches and *adjusted are what the
-// user gets, *rejected the vertex matches the first adjustment rejected.
-int RematchAndAdjust(const Survey& survey,
-                     const SyntheticReconstruction& reconstruction,
-                     const std::vector<ReconstructedLinePoint>* lines,
-                     const std::vector<double>* line_control_times,
-                     const TruthPaintProbe& probe,
-                     const AdjustmentOptions& adjustment, AdjustmentData* data,
-                     std::vector<CrossingDecision> decisions,
-                     AdjustmentResult* adjusted, int* rejected) {
+// One second registration pass as `zebrageo run` does it (pipeline.cc):
+// the matches the adjustment rejected removed, then the pass on the
+// adjusted trajectory (on the road lines' alone when the adjustment had
+// too few crossings). Adds the vertex matches the adjustment rejected to
+// *rejected.
+RematchSummary SecondPass(
+    const Survey& survey, const SyntheticReconstruction& reconstruction,
+    const std::vector<ReconstructedLinePoint>* lines,
+    const std::vector<double>* line_control_times, const TruthPaintProbe& probe,
+    const AdjustmentOptions& adjustment, const AdjustmentResult& adjusted,
+    AdjustmentData* data, std::vector<CrossingDecision>* decisions,
+    int* rejected) {
   std::string rejected_crossings;
-  *rejected = RemoveRejectedMatches(*adjusted, &data->matches, &decisions,
-                                    &rejected_crossings);
+  *rejected += RemoveRejectedMatches(adjusted, &data->matches, decisions,
+                                     &rejected_crossings);
   AdjustmentRecord record =
-      AdjustmentRecordOf(*data, adjustment, *adjusted, nullptr);
+      AdjustmentRecordOf(*data, adjustment, adjusted, nullptr);
   RematchInput first;
   first.vertices = &reconstruction.vertices;
   first.matches = &data->matches;
-  first.decisions = &decisions;
-  first.adjusted_trajectory = &adjusted->corrected_samples;
+  first.decisions = decisions;
+  first.adjusted_trajectory = &adjusted.corrected_samples;
   first.adjustment = &record;
   first.line_control_times = line_control_times;
   std::optional<RoadLinesAdjustment> on_lines;
-  if (SecondPassOnRoadLines(record, decisions, lines != nullptr)) {
+  if (SecondPassOnRoadLines(record, *decisions, lines != nullptr)) {
     AdjustmentData without_matches = *data;
     without_matches.matches.clear();
     on_lines = AdjustByRoadLinesAlone(without_matches, lines, adjustment);
@@ -310,14 +308,42 @@ int RematchAndAdjust(const Survey& survey,
                                const std::vector<BandCornersEnu>& seen) {
     return probe.Classify(exposure_id, pose, band, seen);
   };
-  RematchSummary rematch = RematchWithAdjustedTrajectory(
-      survey, first, MatchOptions(), RematchOptions());
-  if (rematch.added == 0) return 0;
-  data->matches = std::move(rematch.matches);
-  std::vector<std::string> warnings;
-  *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
-                                  &warnings, nullptr, nullptr);
-  return rematch.added;
+  return RematchWithAdjustedTrajectory(survey, first, MatchOptions(),
+                                       RematchOptions());
+}
+
+// What `zebrageo run` does after its first adjustment (pipeline.cc): the
+// second registration pass, and the adjustment again when it added or
+// removed matches (after a removal, the pass once more). Returns the
+// observations it matched; *matches and *adjusted are what the user gets,
+// *rejected the vertex matches the adjustments before a pass rejected.
+int RematchAndAdjust(const Survey& survey,
+                     const SyntheticReconstruction& reconstruction,
+                     const std::vector<ReconstructedLinePoint>* lines,
+                     const std::vector<double>* line_control_times,
+                     const TruthPaintProbe& probe,
+                     const AdjustmentOptions& adjustment, AdjustmentData* data,
+                     std::vector<CrossingDecision> decisions,
+                     AdjustmentResult* adjusted, int* rejected) {
+  constexpr int kMaxPasses = 2;  // pipeline.cc's kMaxRematchPasses
+  int added = 0;
+  *rejected = 0;
+  std::vector<double> times_after;  // line control of a later adjustment
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    RematchSummary rematch =
+        SecondPass(survey, reconstruction, lines,
+                   pass == 0 ? line_control_times : &times_after, probe,
+                   adjustment, *adjusted, data, &decisions, rejected);
+    if (rematch.added == 0 && rematch.dropped == 0) break;
+    added += rematch.added;
+    data->matches = std::move(rematch.matches);
+    decisions = std::move(rematch.decisions);
+    std::vector<std::string> warnings;
+    *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
+                                    &warnings, nullptr, &times_after);
+    if (rematch.dropped == 0) break;
+  }
+  return added;
 }
 
 GeometryRunResult RunGeometrySurvey(uint64_t seed,
