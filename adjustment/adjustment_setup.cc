@@ -171,15 +171,17 @@ void InitialiseCorrection(const Context& context, State* state) {
   context.summary->num_vehicle_motion = static_cast<int>(state->motion.size());
 }
 
-ErrorModel InitialErrorModel(const Context& context,
-                             const std::vector<CrossingDiscrepancy>& crossings,
-                             const State& state) {
+void FitPositionModel(const Context& context,
+                      const std::vector<CrossingDiscrepancy>& crossings,
+                      const State& state, ErrorModel* out) {
   const AdjustmentOptions& options = context.options;
-  ErrorModel model;
+  ErrorModel& model = *out;
   std::vector<bool> use(crossings.size(), false);
   for (const ControlPoint& p : state.points) {
-    if (p.status != ControlStatus::kRejected)
+    if (p.status != ControlStatus::kRejected &&
+        p.crossing < static_cast<int>(crossings.size())) {
       use[p.crossing] = crossings[p.crossing].valid;
+    }
   }
   // Without a control crossing, the road lines' own discrepancies: the
   // error model is fitted on what they show across them and in height.
@@ -218,6 +220,14 @@ ErrorModel InitialErrorModel(const Context& context,
     model.position_level_sigma_m[0] = model.position_level_sigma_m[1];
     model.position_tau_s[0] = model.position_tau_s[1];
   }
+}
+
+ErrorModel InitialErrorModel(const Context& context,
+                             const std::vector<CrossingDiscrepancy>& crossings,
+                             const State& state) {
+  const AdjustmentOptions& options = context.options;
+  ErrorModel model;
+  FitPositionModel(context, crossings, state, &model);
   std::vector<double> sd[3];
   for (const TrajectorySample& s : context.input.trajectory->samples()) {
     for (int axis = 0; axis < 3; ++axis) {

@@ -29,6 +29,13 @@ ErrorModel InitialErrorModel(const Context& context,
                              const std::vector<CrossingDiscrepancy>& d,
                              const State& state);
 
+// The position process of `model` (its position_* members): fitted to the
+// discrepancies of the crossings with a control or check point left, or
+// without any (RoadLinesOnly) to the road lines' (`d` may then be empty).
+void FitPositionModel(const Context& context,
+                      const std::vector<CrossingDiscrepancy>& d,
+                      const State& state, ErrorModel* model);
+
 // Whether road lines are the only control: no zebra control or check
 // point left, matched line points, and line_control_without_crossings.
 bool RoadLinesOnly(const AdjustmentOptions& options, const State& state);

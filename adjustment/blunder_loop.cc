@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "adjustment/adjustment_setup.h"
 #include "adjustment/attitude_significance.h"
 #include "adjustment/variance_components.h"
 #include "survey/math_util.h"
@@ -23,7 +24,18 @@ bool AdjustmentSolver::Adjust() {
   for (int iteration = 0; iteration < options.max_blunder_iterations;
        ++iteration) {
     if (!RejectBlunders()) break;
-    if (!HasControl()) return true;
+    if (!HasControl()) {
+      if (!RoadLinesOnly(options, *state_)) return true;
+      // The last crossing rejected: the road lines alone hold the
+      // trajectory now, solved as when none had been matched (SelectControl):
+      // along the track nothing measures it (a height misfit on a grade
+      // would move it by metres), and the position process is the lines'.
+      state_->along_track_held = true;
+      FitPositionModel(context_, {}, *state_, &state_->model);
+      adjustment_internal::ResetState(state_);
+      if (!SolveTwice()) return false;
+      break;
+    }
     adjustment_internal::ResetState(state_);
     if (!SolveTwice()) return false;
   }

@@ -133,6 +133,42 @@ TEST_F(LineOnlyAdjustment, CorrectsAcrossAndInHeightKeepsAlongTrack) {
   EXPECT_LT(result.summary.median_posterior_sd_vertical_m, 0.05);
 }
 
+// A crossing the lines contradict (its database copy a metre across the
+// road) is rejected in the blunder loop; the lines alone then hold the
+// trajectory as when nothing was matched: along the track it stays the
+// input's (a height misfit on the grade must not move it).
+TEST_F(LineOnlyAdjustment, ACrossingRejectedLeavesTheLinesAloneAsWithout) {
+  ASSERT_FALSE(survey_.matches.empty());
+  const std::string crossing = survey_.matches.front().crossing_id;
+  std::vector<VertexMatch> matches;
+  for (const VertexMatch& m : survey_.matches) {
+    if (m.crossing_id == crossing) matches.push_back(m);
+  }
+  RoadmarkDatabase moved = survey_.database;
+  for (RoadmarkBand& band : moved.bands) {
+    if (band.crossing_id != crossing) continue;
+    for (Geodetic& corner : band.corners) {
+      corner = survey_.frame.GeodeticFromEnu(
+          survey_.frame.EnuFromGeodetic(corner) + Eigen::Vector3d(0, 1.0, 0));
+    }
+  }
+  AdjustmentInput input = SyntheticAdjustmentInput(survey_, trajectory_);
+  input.matches = &matches;
+  input.roadmarks = &moved;
+  input.line_points = &lines_;
+  const AdjustmentResult result = AdjustTrajectory(AdjustmentOptions(), input);
+  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
+  ASSERT_EQ(result.summary.num_control_crossings, 0)
+      << "the shifted crossing was kept: " << result.summary.BriefReport();
+  EXPECT_TRUE(result.summary.line_control_only);
+  const Eigen::Vector3d before = InputErrors();
+  const Eigen::Vector3d after =
+      TrackErrors(survey_, result.corrected_samples, result.corrected_poses);
+  EXPECT_NEAR(after.x(), before.x(), 0.005);
+  EXPECT_LT(after.y(), 0.04);
+  EXPECT_LT(after.z(), 0.04);
+}
+
 TEST_F(LineOnlyAdjustment, CanBeTurnedOff) {
   AdjustmentOptions options;
   options.line_control_without_crossings = false;
