@@ -127,6 +127,48 @@ double PositionSigma(const AdjustmentOptions& options,
       options.min_position_sigma_m, options.max_position_sigma_m);
 }
 
+// With zebra control and road lines: the lines measure the error across
+// the track and in height between the crossings, where one or two
+// crossings (their discrepancies near zero) fit the process to its floor
+// and make a metre-size multipath switch the lines show impossible, and
+// the right crossing a blunder. On an axis (across, up) the crossings fit
+// to the floor, the process is as large as the lines show; its correlation
+// time stays the crossings' (a switch fitted as a long-correlated process
+// would be too stiff).
+void WidenByLines(const AdjustmentOptions& options, const State& state,
+                  ErrorModel* model) {
+  const std::vector<CrossingDiscrepancy> seen =
+      LineDiscrepancies(state, options.line_discrepancy_bin_s,
+                        options.line_discrepancy_min_points);
+  if (seen.empty()) return;
+  const std::vector<bool> all(seen.size(), true);
+  const std::vector<GaussMarkovFit> fits =
+      adjustment_internal::FitAxes(seen, all, PositionFitOptions(options));
+  for (int axis = 1; axis < 3; ++axis) {
+    // Where the crossings show a drift, their fit stands (the lines'
+    // discrepancies hold the database lines' own errors too).
+    if (model->position_sigma_m[axis] > options.min_position_sigma_m) continue;
+    const double level =
+        PositionSigma(options, seen, all, axis, fits[axis].sigma);
+    // The exposures' jitter, modelled on its own, is in the lines' too.
+    const double jitter = model->jitter_sigma_m[axis];
+    const double sigma =
+        level > options.min_position_sigma_m
+            ? std::max(
+                  options.min_position_sigma_m,
+                  std::sqrt(std::max(0.0, fits[axis].sigma * fits[axis].sigma -
+                                              jitter * jitter)))
+            : options.min_position_sigma_m;
+    VLOG(1) << "error model axis " << axis << ": crossings "
+            << model->position_sigma_m[axis] << " m, road lines " << sigma
+            << " m (level " << level << " m)";
+    model->position_level_sigma_m[axis] =
+        std::max(model->position_level_sigma_m[axis], level);
+    model->position_sigma_m[axis] =
+        std::max(model->position_sigma_m[axis], sigma);
+  }
+}
+
 }  // namespace
 
 void InitialiseCorrection(const Context& context, State* state) {
@@ -212,6 +254,10 @@ void FitPositionModel(const Context& context,
       model.position_tau_s[axis] = fits[axis].tau_s;
     }
   }
+  if (lines.empty() && !state.lines.empty() &&
+      options.estimate_position_model) {
+    WidenByLines(options, state, &model);
+  }
   if (!lines.empty()) {
     // Nothing measures the along-track error (the correction is held there,
     // State::along_track_held); the cross-track one the lines show is the
@@ -227,7 +273,6 @@ ErrorModel InitialErrorModel(const Context& context,
                              const State& state) {
   const AdjustmentOptions& options = context.options;
   ErrorModel model;
-  FitPositionModel(context, crossings, state, &model);
   std::vector<double> sd[3];
   for (const TrajectorySample& s : context.input.trajectory->samples()) {
     for (int axis = 0; axis < 3; ++axis) {
@@ -259,6 +304,8 @@ ErrorModel InitialErrorModel(const Context& context,
         " about a smooth path): each exposure's position is corrected on its "
         "own where the data allow");
   }
+  // After the jitter: the road lines' discrepancies hold it too.
+  FitPositionModel(context, crossings, state, &model);
   LOG(INFO) << "adjustment: GNSS/INS error model: position sigma "
             << model.position_sigma_m.transpose() << " m, tau "
             << model.position_tau_s.transpose() << " s; attitude sigma "

@@ -30,8 +30,10 @@ ErrorModel InitialErrorModel(const Context& context,
                              const State& state);
 
 // The position process of `model` (its position_* members): fitted to the
-// discrepancies of the crossings with a control or check point left, or
-// without any (RoadLinesOnly) to the road lines' (`d` may then be empty).
+// discrepancies of the crossings with a control or check point left (with
+// road lines, on an axis across the track or in height where those fit to
+// the floor, as large as the lines show), or without any (RoadLinesOnly)
+// to the road lines' (`d` may then be empty).
 void FitPositionModel(const Context& context,
                       const std::vector<CrossingDiscrepancy>& d,
                       const State& state, ErrorModel* model);
