@@ -64,6 +64,15 @@ std::string BandOptions::Check() const {
   } else if (!(end_step_profile_px >= 1.0)) {
     error << "end_step_profile_px = " << end_step_profile_px
           << ": must be >= 1";
+  } else if (!(end_angle_full_range_m > 0.0)) {
+    error << "end_angle_full_range_m = " << end_angle_full_range_m
+          << ": must be > 0";
+  } else if (!(end_angle_min_share > 0.0 && end_angle_min_share <= 1.0)) {
+    error << "end_angle_min_share = " << end_angle_min_share
+          << ": must be in (0, 1]";
+  } else if (!(max_end_disagreement_rad_per_m > 0.0)) {
+    error << "max_end_disagreement_rad_per_m = "
+          << max_end_disagreement_rad_per_m << ": must be > 0";
   } else if (completion_min_bands < 3) {
     error << "completion_min_bands = " << completion_min_bands
           << ": must be >= 3";

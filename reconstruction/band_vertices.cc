@@ -348,16 +348,37 @@ void ScoreBand(const BandContext& context, int i, const KnownEnd known[2],
 // A painted end is parallel to its crossing's (a stain's slanted edge
 // cutting the paint is not): each end's own direction, averaged over the
 // two images (a far end's angle is noisy in each), within
-// max_end_angle_rad of the crossing's.
+// max_end_angle_rad of the crossing's (less near); and the two images
+// agree on it
+// within max_end_disagreement_rad_per_m times the band's range.
 bool EndsAlongTheCrossing(const BandContext& context, int i,
                           const KnownEnd known[2], const BandViews& views) {
+  const BandOptions& options = context.options;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (int v = 0; v < 4; ++v) centre += views.vertex_sum[v];
+  centre /= 4.0 * std::max(1, views.views);
+  const double range =
+      (centre - context.rectification.left_centre_body()).norm();
+  const double max_disagreement =
+      options.max_end_disagreement_rad_per_m * range;
+  // The mean direction is measured better near: its limit shrinks in
+  // proportion to the range below end_angle_full_range_m.
+  const double max_angle = options.max_end_angle_rad *
+                           std::clamp(range / options.end_angle_full_range_m,
+                                      options.end_angle_min_share, 1.0);
   for (int e = 0; e < 2; ++e) {
     if (known[e].direction == nullptr || known[e].line != nullptr) continue;
     const double angle =
         0.5 * (views.ends.free_angle[0][e] + views.ends.free_angle[1][e]);
-    if (!(std::abs(angle) <= context.options.max_end_angle_rad)) {
+    // Both images are orthoimages of the road: a painted end has one
+    // direction in both (a stain's edge, or a shadow's, need not).
+    const double disagreement =
+        std::abs(views.ends.free_angle[0][e] - views.ends.free_angle[1][e]);
+    if (!(std::abs(angle) <= max_angle) ||
+        !(disagreement <= max_disagreement)) {
       VLOG(2) << "band " << i << " end " << e << ": " << angle
-              << " rad from the crossing's ends";
+              << " rad from the crossing's ends, the images " << disagreement
+              << " rad apart";
       return false;
     }
   }
