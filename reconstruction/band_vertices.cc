@@ -349,8 +349,7 @@ void ScoreBand(const BandContext& context, int i, const KnownEnd known[2],
 // cutting the paint is not): each end's own direction, averaged over the
 // two images (a far end's angle is noisy in each), within
 // max_end_angle_rad of the crossing's (less near); and the two images
-// agree on it
-// within max_end_disagreement_rad_per_m times the band's range.
+// agree on it within max_end_disagreement_rad_per_m times the band's range.
 bool EndsAlongTheCrossing(const BandContext& context, int i,
                           const KnownEnd known[2], const BandViews& views) {
   const BandOptions& options = context.options;
