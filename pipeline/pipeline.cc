@@ -4,7 +4,9 @@
 #include <sys/resource.h>
 
 #include <optional>
+#include <set>
 #include <sstream>
+#include <string>
 #include <utility>
 
 #include "pipeline/exit_codes.h"
@@ -90,6 +92,8 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
     line_times = LineControlTimesIn(results->folder(), survey.exposures);
   }
   first.line_control_times = &line_times;
+  const std::set<std::string> rejected = RejectedCrossingsIn(results->folder());
+  first.rejected_crossings = &rejected;
   std::optional<RoadLinesAdjustment> lines;
   if (first.adjustment != nullptr &&
       SecondPassOnRoadLines(*first.adjustment, results->Decisions(),
@@ -120,10 +124,12 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
 }
 
 // adjust (with road lines: line matching and a second adjustment inside
-// RunAdjustStage), then the second registration pass and, if it added
-// or removed matches, the adjustment again (and after a removal, the
-// second pass once more).
-constexpr int kMaxRematchPasses = 2;
+// RunAdjustStage), then the second registration pass and, while it adds
+// or removes matches, the adjustment and the pass again. A pass on the
+// road lines' trajectory (too few crossings to trust their error model)
+// that matched crossings across the track leaves a trajectory the
+// crossings corrected along it too: the next pass searches with that one.
+constexpr int kMaxRematchPasses = 3;
 std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
                                 const RunOptions& options,
                                 const ProgressListener& progress) {
@@ -138,7 +144,7 @@ std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
   // Crossings the first pass could not decide, matched again with the
   // adjusted trajectory. A pass that refused first-pass crossings it
   // contradicts adds nothing: the adjustment without them is another
-  // trajectory, searched once more.
+  // trajectory, searched again, as is one with more crossings.
   std::vector<std::string> refusals;
   for (int pass = 0; pass < kMaxRematchPasses; ++pass) {
     const RematchSummary rematch = Rematch(survey, results, options);
@@ -150,7 +156,7 @@ std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
       AddOutputCrs(survey, results->folder());
       break;
     }
-    const bool again = rematch.dropped > 0 && pass + 1 < kMaxRematchPasses;
+    const bool again = pass + 1 < kMaxRematchPasses;
     warnings =
         RunAdjustStage(survey, results, again ? first : options.adjustment,
                        options.tie_points, options.lines, progress);

@@ -15,6 +15,7 @@
 #define ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_
 
 #include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -133,7 +134,15 @@ struct RematchInput {
   // cross-track position (LineControlTimes); null: none, and the pass
   // searches nothing.
   const std::vector<double>* line_control_times = nullptr;
+  // Crossings the adjustment rejected as inconsistent with the others
+  // (gcp_residuals.csv's status rejected); null: none. The pass matches
+  // nothing to them again: the next adjustment would face the same
+  // conflict and might reject the other side of it instead.
+  const std::set<std::string>* rejected_crossings = nullptr;
 };
+// The crossings of results_folder's gcp_residuals.csv with a rejected
+// vertex; empty without the file.
+std::set<std::string> RejectedCrossingsIn(const std::string& results_folder);
 // The times of the exposures of line_matches.csv's rows that constrain
 // the position across their line, sorted.
 std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,

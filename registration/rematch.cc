@@ -204,8 +204,12 @@ void DropContradicted(const std::set<std::string>& contradicted,
 std::vector<CrossingDecision> MergeSecondPass(
     const std::vector<CrossingDecision>& first, const MatchResult& second,
     const std::map<std::pair<int64_t, int64_t>, std::set<int64_t>>& bands_of,
-    const RematchOptions& rematch, bool road_lines_only,
+    const RematchOptions& rematch, const RematchInput& input,
     std::vector<VertexMatch>* matches, RematchSummary* summary) {
+  const std::set<std::string> none;
+  const std::set<std::string>& rejected =
+      input.rejected_crossings != nullptr ? *input.rejected_crossings : none;
+  const bool road_lines_only = input.adjustment->road_lines_only;
   std::vector<CrossingDecision> merged = first;
   for (CrossingDecision& d : merged) {
     if (d.decision == Decision::kMatched) continue;
@@ -219,6 +223,12 @@ std::vector<CrossingDecision> MergeSecondPass(
         VLOG(1) << "second pass: exposure " << d.exposure_id << " group "
                 << d.group_id << " still undecided: " << it->reason;
       }
+      continue;
+    }
+    if (rejected.count(it->crossing_id)) {
+      VLOG(1) << "second pass: exposure " << d.exposure_id << " group "
+              << d.group_id << " not matched again to " << it->crossing_id
+              << ", which the adjustment rejected";
       continue;
     }
     const auto bands = bands_of.find({d.exposure_id, d.group_id});
@@ -297,9 +307,8 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
     summary.message = message.str();
     LOG(WARNING) << summary.message;
   } else {
-    merged =
-        MergeSecondPass(*first.decisions, second, bands_of, rematch,
-                        first.adjustment->road_lines_only, &matches, &summary);
+    merged = MergeSecondPass(*first.decisions, second, bands_of, rematch, first,
+                             &matches, &summary);
     std::ostringstream message;
     message << "second registration pass with the adjusted trajectory: "
             << summary.added << " of " << summary.observations
@@ -339,6 +348,17 @@ std::vector<double> LineControlTimesIn(const std::string& results_folder,
   if (!fs::exists(path)) return {};
   return LineControlTimes(ReadLineMatches(path.string(), kLineMatchesFile),
                           exposures);
+}
+
+std::set<std::string> RejectedCrossingsIn(const std::string& results_folder) {
+  const fs::path path = fs::path(results_folder) / kGcpResidualsFile;
+  std::set<std::string> crossings;
+  if (!fs::exists(path)) return crossings;
+  for (const GcpResidual& r :
+       ReadGcpResiduals(path.string(), kGcpResidualsFile)) {
+    if (r.status == GcpStatus::kRejected) crossings.insert(r.crossing_id);
+  }
+  return crossings;
 }
 
 void WriteRematchResults(const RematchSummary& summary,
@@ -405,6 +425,8 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
     line_times = LineControlTimesIn(results_folder, survey.exposures);
   }
   first.line_control_times = &line_times;
+  const std::set<std::string> rejected = RejectedCrossingsIn(results_folder);
+  first.rejected_crossings = &rejected;
   const RematchSummary summary =
       RematchWithAdjustedTrajectory(survey, first, options, rematch);
   WriteRematchResults(summary, results_folder);

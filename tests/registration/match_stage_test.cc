@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
@@ -344,6 +345,40 @@ TEST_F(SecondPassTest, AnAdjustedTrajectoryOneBandOffIsNotTrusted) {
     EXPECT_EQ(contradicted.count(m.crossing_id), 0u) << m.crossing_id;
   }
   EXPECT_EQ(ScoreMatches(scene_, after).wrong, 0);
+}
+
+// A crossing the adjustment rejected (gcp_residuals.csv) is not matched
+// again: the next adjustment would face the same conflict and might reject
+// the other side of it instead (geometry seed 969 flip-flopped so, H 26.5
+// -> 120.8 cm). The pass still matches the other crossings.
+TEST_F(SecondPassTest, NothingIsMatchedAgainToACrossingTheAdjustmentRejected) {
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(0.03, -0.02), true,
+                          folder_.Path("results"));
+  // What the pass adds when nothing is rejected, in a copy of the results.
+  std::filesystem::copy(folder_.Path("results"), folder_.Path("unrejected"));
+  RematchWithAdjustedTrajectory(survey_, folder_.Path("unrejected"),
+                                MatchOptions(), RematchOptions());
+  std::map<std::string, int> added;
+  for (const CrossingDecision& d : ReadCrossingDecisions(
+           folder_.Path("unrejected/crossing_decisions.csv"), "decisions")) {
+    if (d.reason.find("second pass") != std::string::npos) {
+      ++added[d.crossing_id];
+    }
+  }
+  ASSERT_FALSE(added.empty()) << "the scene no longer needs a second pass";
+  const std::string rejected = added.begin()->first;
+  GcpResidual residual;
+  residual.crossing_id = rejected;
+  residual.band = 1;
+  residual.status = GcpStatus::kRejected;
+  WriteGcpResiduals({residual}, folder_.Path("results/gcp_residuals.csv"));
+  const RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
+  int total = 0;
+  for (const auto& [crossing, n] : added) total += n;
+  EXPECT_EQ(summary.added, total - added[rejected]) << summary.message;
+  for (const VertexMatch& m : Matches()) EXPECT_NE(m.crossing_id, rejected);
+  EXPECT_EQ(ScoreMatches(scene_, Matches()).wrong, 0);
 }
 
 TEST_F(SecondPassTest, WithoutAPosteriorSdNothingIsDone) {

@@ -47,5 +47,32 @@ TEST(GeometryRegressions, Seed844OneCrossingAndAMultipathSwitchSeenByLines) {
   EXPECT_LT(r.h_after_m, 0.25) << r.Line();
 }
 
+// Five crossings, none decided by the first pass: the pass on the road
+// lines' trajectory matched three (across the track), and only a further
+// pass on the trajectory those three corrected along it too found the
+// other two (H 16.7 cm with three, 3.9 with five).
+TEST(GeometryRegressions, Seed494APassOnTheCrossingsAfterOneOnTheLines) {
+  const GeometryRunResult r = RunSeed(494);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_EQ(r.crossings_matched, 5) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.08) << r.Line();
+}
+
+// Two crossings 1.1 m apart in their corrections (a multipath switch
+// between them): each adjustment rejects one, and a pass that matched the
+// rejected one again had the next adjustment reject the other, flip-flop
+// (H 26.5 -> 120.8 cm, worse than the input's 93.1). A crossing the
+// adjustment rejected is not matched again.
+TEST(GeometryRegressions, Seed969ARejectedCrossingIsNotMatchedAgain) {
+  const GeometryRunResult r = RunSeed(969);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_FALSE(r.worse_position) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.4) << r.Line();
+}
+
 }  // namespace
 }  // namespace zebrageo::support

@@ -280,9 +280,9 @@ RematchSummary SecondPass(
     const AdjustmentOptions& adjustment, const AdjustmentResult& adjusted,
     AdjustmentData* data, std::vector<CrossingDecision>* decisions,
     int* rejected) {
-  std::string rejected_crossings;
+  std::string rejected_list;
   *rejected += RemoveRejectedMatches(adjusted, &data->matches, decisions,
-                                     &rejected_crossings);
+                                     &rejected_list);
   AdjustmentRecord record =
       AdjustmentRecordOf(*data, adjustment, adjusted, nullptr);
   RematchInput first;
@@ -292,6 +292,13 @@ RematchSummary SecondPass(
   first.adjusted_trajectory = &adjusted.corrected_samples;
   first.adjustment = &record;
   first.line_control_times = line_control_times;
+  std::set<std::string> rejected_crossings;
+  for (const ControlPointResult& p : adjusted.control_points) {
+    if (p.status == ControlStatus::kRejected) {
+      rejected_crossings.insert(p.crossing_id);
+    }
+  }
+  first.rejected_crossings = &rejected_crossings;
   std::optional<RoadLinesAdjustment> on_lines;
   if (SecondPassOnRoadLines(record, *decisions, lines != nullptr)) {
     AdjustmentData without_matches = *data;
@@ -313,8 +320,8 @@ RematchSummary SecondPass(
 }
 
 // What `zebrageo run` does after its first adjustment (pipeline.cc): the
-// second registration pass, and the adjustment again when it added or
-// removed matches (after a removal, the pass once more). Returns the
+// second registration pass and, while it adds or removes matches, the
+// adjustment and the pass again (three passes at most). Returns the
 // observations it matched; *matches and *adjusted are what the user gets,
 // *rejected the vertex matches the adjustments before a pass rejected.
 int RematchAndAdjust(const Survey& survey,
@@ -325,7 +332,7 @@ int RematchAndAdjust(const Survey& survey,
                      const AdjustmentOptions& adjustment, AdjustmentData* data,
                      std::vector<CrossingDecision> decisions,
                      AdjustmentResult* adjusted, int* rejected) {
-  constexpr int kMaxPasses = 2;  // pipeline.cc's kMaxRematchPasses
+  constexpr int kMaxPasses = 3;  // pipeline.cc's kMaxRematchPasses
   int added = 0;
   *rejected = 0;
   std::vector<double> times_after;  // line control of a later adjustment
@@ -341,7 +348,6 @@ int RematchAndAdjust(const Survey& survey,
     std::vector<std::string> warnings;
     *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
                                     &warnings, nullptr, &times_after);
-    if (rematch.dropped == 0) break;
   }
   return added;
 }
