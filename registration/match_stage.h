@@ -104,6 +104,18 @@ struct RematchOptions {
   // (1 m less the gate). 12 m keeps it under 0.45 m. (Geometry sweep
   // 1-500 with a gap in time: 1 and 1.5 s clean, 2 s let 8 wrong in.)
   double max_line_control_gap_m = 12.0;
+  // Farther, an observation is searched when the road lines' own error
+  // model (the adjustment's, fitted to their discrepancies: sigma and tau
+  // across the track) predicts the cross-track error to change over its
+  // time from the nearest such point by at most this sd: a band offset
+  // lies 0.7 m (the period less the gate) away, 4 sd. Lines that show a
+  // multipath switch fit a large sigma and keep such searches short.
+  // The observation must lie between two such points, each at most
+  // max_line_bracket_gap_s away: beyond the last one, or over a long gap,
+  // a switch the lines did not see is unbounded (seen: 1.6 s beyond the
+  // last point, 16 wrong vertex matches).
+  double max_line_drift_sd_m = 0.175;
+  double max_line_bracket_gap_s = 8.0;
   std::string Check() const;
 };
 struct RematchSummary {

@@ -4,7 +4,9 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -38,6 +40,14 @@ std::string RematchOptions::Check() const {
       !std::isfinite(max_line_control_gap_m)) {
     return "max_line_control_gap_m = " +
            std::to_string(max_line_control_gap_m) + ": must be finite and >= 0";
+  }
+  if (!(max_line_drift_sd_m >= 0.0) || !std::isfinite(max_line_drift_sd_m)) {
+    return "max_line_drift_sd_m = " + std::to_string(max_line_drift_sd_m) +
+           ": must be finite and >= 0";
+  }
+  if (!(max_line_bracket_gap_s >= 0.0)) {
+    return "max_line_bracket_gap_s = " +
+           std::to_string(max_line_bracket_gap_s) + ": must be >= 0";
   }
   if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
     return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
@@ -92,6 +102,45 @@ bool NearAny(const std::vector<double>& sorted, double t,
   return false;
 }
 
+// The seconds from `t` to the farther of the `sorted` times just before
+// and just after it (infinity unless there are both): between two line
+// points the lines bound the error on both sides; beyond the last one a
+// switch they did not see is unbounded.
+double BracketGap(const std::vector<double>& sorted, double t) {
+  const auto after = std::lower_bound(sorted.begin(), sorted.end(), t);
+  if (after == sorted.end() || after == sorted.begin()) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return std::max(*after - t, t - *(after - 1));
+}
+
+// The sd of the change of the cross-track error over `dt` seconds by the
+// adjustment's position model (a first-order Gauss-Markov process on
+// each axis: var = 2 sigma^2 (1 - exp(-dt / tau))); infinity when the
+// record has no estimated model.
+double CrossTrackDriftSd(const AdjustmentRecord& record, double dt) {
+  const auto& model = record.model;
+  const double sigma =
+      std::max(model.position_sigma_m.x(), model.position_sigma_m.y());
+  const double tau =
+      std::min(model.position_tau_s.x(), model.position_tau_s.y());
+  if (!model.position_model_estimated || !(tau > 0.0) || !(sigma > 0.0) ||
+      !std::isfinite(dt)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return sigma * std::sqrt(2.0 * (1.0 - std::exp(-dt / tau)));
+}
+
+// Whether the road lines bound the cross-track error at time `t`, beyond
+// max_line_control_gap_m of them (RematchOptions::max_line_drift_sd_m).
+bool BoundedByLines(const AdjustmentRecord& record,
+                    const std::vector<double>& line_times, double t,
+                    const RematchOptions& rematch) {
+  const double gap_s = BracketGap(line_times, t);
+  return gap_s <= rematch.max_line_bracket_gap_s &&
+         CrossTrackDriftSd(record, gap_s) <= rematch.max_line_drift_sd_m;
+}
+
 // The second pass: the bands matched again on the survey as the adjustment
 // left it (its corrected trajectory), with the rematch gates. *bands_of:
 // the band ids of each observation (exposure, group).
@@ -120,7 +169,9 @@ MatchResult MatchOnAdjustedTrajectory(
   }
   MatchOptions tight = options;
   if (first.adjustment->road_lines_only) {
-    // Only where the lines measured the cross-track position.
+    // Only where the lines measured the cross-track position: near one of
+    // their points, or between two where their own error model says it
+    // cannot have moved by a band offset.
     const std::vector<double> none;
     const std::vector<double>& times =
         first.line_control_times != nullptr ? *first.line_control_times : none;
@@ -128,7 +179,9 @@ MatchResult MatchOnAdjustedTrajectory(
         std::remove_if(input.observations.begin(), input.observations.end(),
                        [&](const CrossingObservation& o) {
                          return !NearAny(times, o.time_s, adjusted.trajectory,
-                                         rematch.max_line_control_gap_m);
+                                         rematch.max_line_control_gap_m) &&
+                                !BoundedByLines(*first.adjustment, times,
+                                                o.time_s, rematch);
                        }),
         input.observations.end());
     // Road lines corrected the trajectory across the track and in height:

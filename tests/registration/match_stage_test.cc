@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -455,6 +456,62 @@ TEST_F(SecondPassTest, AfterRoadLinesAloneOnlyWhereTheLinesHeldIt) {
       survey_, folder_.Path("results"), MatchOptions(), RematchOptions());
   EXPECT_EQ(summary.added, 0) << summary.message;
   EXPECT_EQ(Undecided(), undecided);
+}
+
+// Road lines every `period_s` seconds up to `until_s` (line_matches.csv),
+// and the lines' fitted error model across the track in adjustment.json.
+void WriteSparseLines(const SyntheticScene& scene, double period_s,
+                      double until_s, double sigma_m,
+                      const std::string& results) {
+  std::vector<LineMatch> rows;
+  for (const ExposurePose& e : scene.exposures) {
+    const double phase = std::fmod(e.time_s + 1e-6, period_s);
+    if (e.time_s > until_s || phase > 0.1) continue;
+    LineMatch row;
+    row.exposure_id = e.exposure_id;
+    row.line_id = e.exposure_id;
+    row.db_line = "lane";
+    row.across_enu = Eigen::Vector2d(0.0, 1.0);
+    rows.push_back(row);
+  }
+  WriteLineMatches(rows, results + "/" + kLineMatchesFile);
+  const std::string path = results + "/" + kAdjustmentJsonFile;
+  AdjustmentRecord record = ReadAdjustmentRecord(path, kAdjustmentJsonFile);
+  record.model.position_model_estimated = true;
+  record.model.position_sigma_m = Eigen::Vector3d(sigma_m, sigma_m, 0.03);
+  record.model.position_tau_s = Eigen::Vector3d::Constant(30.0);
+  WriteAdjustmentRecord(record, path);
+}
+
+// Lines every 5 s (40 m at 8 m/s): between two of them, farther than
+// max_line_control_gap_m from both, an observation is searched when the
+// lines' model says the cross-track error barely changes over the gap;
+// not when it shows a metre-size process (a multipath switch), nor beyond
+// the last line point.
+TEST_F(SecondPassTest, AfterRoadLinesAloneBetweenLinesAsTheirModelAllows) {
+  ASSERT_GT(Undecided(), 0);
+  WriteAdjustedTrajectory(scene_, Eigen::Vector2d(1.5, 0.04), true,
+                          folder_.Path("results"), 0, true, false);
+  const auto added = [&](const std::string& name, double until_s,
+                         double sigma_m) {
+    const std::string results = folder_.Path(name);
+    std::filesystem::copy(folder_.Path("results"), results);
+    WriteSparseLines(scene_, 5.0, until_s, sigma_m, results);
+    const RematchSummary summary = RematchWithAdjustedTrajectory(
+        survey_, results, MatchOptions(), RematchOptions());
+    EXPECT_EQ(ScoreMatches(scene_,
+                           ReadMatches(results + "/matches.csv", "matches.csv"))
+                  .wrong,
+              0)
+        << name;
+    return summary.added;
+  };
+  const double end_s = scene_.exposures.back().time_s;
+  const int steady = added("steady", end_s, 0.1);
+  const int switching = added("switching", end_s, 2.3);
+  const int beyond = added("beyond", 0.0, 0.1);
+  EXPECT_GT(steady, switching) << steady << " against " << switching;
+  EXPECT_EQ(beyond, 0);
 }
 
 TEST(RematchOptions, CrossTrackGateUnderHalfABand) {
