@@ -176,6 +176,17 @@ TEST(MatchStage, RejectsBandsOfAnExposureTheSurveyDoesNotHave) {
   }
 }
 
+// A line_matches.csv row: a lane line seen from exposure `e` holding the
+// position across the track (north).
+LineMatch LaneLineAt(const ExposurePose& e) {
+  LineMatch row;
+  row.exposure_id = e.exposure_id;
+  row.line_id = e.exposure_id;
+  row.db_line = "lane";
+  row.across_enu = Eigen::Vector2d(0.0, 1.0);
+  return row;
+}
+
 // The "adjusted" trajectory of the second pass: the true poses shifted by
 // `shift_enu_m`, with a posterior sd of 3 cm, and an adjustment.json that
 // says the sd is posterior (`posterior` false: it is not) and how many
@@ -192,12 +203,7 @@ void WriteAdjustedTrajectory(const SyntheticScene& scene,
     std::vector<LineMatch> rows;
     for (const ExposurePose& e : scene.exposures) {
       if (!lines_everywhere) break;
-      LineMatch row;
-      row.exposure_id = e.exposure_id;
-      row.line_id = e.exposure_id;
-      row.db_line = "lane";
-      row.across_enu = Eigen::Vector2d(0.0, 1.0);
-      rows.push_back(row);
+      rows.push_back(LaneLineAt(e));
     }
     WriteLineMatches(rows, results + "/" + kLineMatchesFile);
   }
@@ -467,12 +473,7 @@ void WriteSparseLines(const SyntheticScene& scene, double period_s,
   for (const ExposurePose& e : scene.exposures) {
     const double phase = std::fmod(e.time_s + 1e-6, period_s);
     if (e.time_s > until_s || phase > 0.1) continue;
-    LineMatch row;
-    row.exposure_id = e.exposure_id;
-    row.line_id = e.exposure_id;
-    row.db_line = "lane";
-    row.across_enu = Eigen::Vector2d(0.0, 1.0);
-    rows.push_back(row);
+    rows.push_back(LaneLineAt(e));
   }
   WriteLineMatches(rows, results + "/" + kLineMatchesFile);
   const std::string path = results + "/" + kAdjustmentJsonFile;
