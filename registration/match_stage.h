@@ -106,14 +106,14 @@ struct RematchOptions {
   double max_line_control_gap_m = 12.0;
   // Farther, an observation is searched when the road lines' own error
   // model (the adjustment's, fitted to their discrepancies: sigma and tau
-  // across the track) predicts the cross-track error to change over its
-  // time from the nearest such point by at most this sd: a band offset
-  // lies 0.7 m (the period less the gate) away, 4 sd. Lines that show a
-  // multipath switch fit a large sigma and keep such searches short.
-  // The observation must lie between two such points, each at most
-  // max_line_bracket_gap_s away: beyond the last one, or over a long gap,
-  // a switch the lines did not see is unbounded (seen: 1.6 s beyond the
-  // last point, 16 wrong vertex matches).
+  // across the track) predicts the cross-track error to change by at most
+  // this sd over its time from the farther of the two such points around
+  // it: a band offset lies 0.7 m (the period less the gate) away, 4 sd.
+  // Lines that show a multipath switch fit a large sigma and keep such
+  // searches short. Both points must be at most max_line_bracket_gap_s
+  // away: beyond the last one, or over a long gap, a switch the lines did
+  // not see is unbounded (seen: 1.6 s beyond the last point, 16 wrong
+  // vertex matches).
   double max_line_drift_sd_m = 0.175;
   double max_line_bracket_gap_s = 8.0;
   std::string Check() const;
