@@ -469,6 +469,14 @@ std::set<std::tuple<std::string, int, int>> RejectedVertices(
 
 }  // namespace
 
+std::set<std::string> RejectedCrossings(const AdjustmentResult& result) {
+  std::set<std::string> crossings;
+  for (const auto& vertex : RejectedVertices(result)) {
+    crossings.insert(std::get<0>(vertex));
+  }
+  return crossings;
+}
+
 std::vector<VertexMatch> MatchesKeptAsControl(
     const std::vector<VertexMatch>& matches, const AdjustmentResult& result) {
   const auto rejected = RejectedVertices(result);
@@ -490,10 +498,8 @@ int RemoveRejectedMatches(const AdjustmentResult& result,
   std::vector<VertexMatch> kept = MatchesKeptAsControl(*matches, result);
   const int removed = static_cast<int>(matches->size() - kept.size());
   if (removed == 0) return 0;
-  std::set<std::string> crossings;
-  for (const auto& vertex : rejected) crossings.insert(std::get<0>(vertex));
   rejected_crossings->clear();
-  for (const std::string& id : crossings) {
+  for (const std::string& id : RejectedCrossings(result)) {
     *rejected_crossings += (rejected_crossings->empty() ? "" : " ") + id;
   }
   std::map<int64_t, int> kept_per_exposure;

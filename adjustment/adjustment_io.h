@@ -23,6 +23,7 @@
 #ifndef ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_IO_H_
 #define ZEBRAGEO_ADJUSTMENT_ADJUSTMENT_IO_H_
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,9 @@ AdjustmentRecord WriteAdjustmentResults(const AdjustmentData& data,
 // matches.csv keeps (below), and what a user's control is made of.
 std::vector<VertexMatch> MatchesKeptAsControl(
     const std::vector<VertexMatch>& matches, const AdjustmentResult& result);
+
+// The crossings with a control point the adjustment rejected.
+std::set<std::string> RejectedCrossings(const AdjustmentResult& result);
 
 // matches.csv holds the vertices that became control points
 // (SURVEY_FORMAT.md): the ones the adjustment rejected (a crossing

@@ -280,7 +280,7 @@ RematchSummary SecondPass(
     const AdjustmentOptions& adjustment, const AdjustmentResult& adjusted,
     AdjustmentData* data, std::vector<CrossingDecision>* decisions,
     int* rejected) {
-  std::string rejected_list;
+  std::string rejected_list;  // RemoveRejectedMatches' message
   *rejected += RemoveRejectedMatches(adjusted, &data->matches, decisions,
                                      &rejected_list);
   AdjustmentRecord record =
@@ -292,12 +292,7 @@ RematchSummary SecondPass(
   first.adjusted_trajectory = &adjusted.corrected_samples;
   first.adjustment = &record;
   first.line_control_times = line_control_times;
-  std::set<std::string> rejected_crossings;
-  for (const ControlPointResult& p : adjusted.control_points) {
-    if (p.status == ControlStatus::kRejected) {
-      rejected_crossings.insert(p.crossing_id);
-    }
-  }
+  const std::set<std::string> rejected_crossings = RejectedCrossings(adjusted);
   first.rejected_crossings = &rejected_crossings;
   std::optional<RoadLinesAdjustment> on_lines;
   if (SecondPassOnRoadLines(record, *decisions, lines != nullptr)) {
