@@ -42,6 +42,12 @@ struct LineControlPoint {
   double grade = 0.0;  // of the database segment: dz per horizontal metre
   // Whitening of [across, up] (2 x 2, lower triangular).
   Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
+  // A dash's centre on the database dash's (registration/dash_matcher.h):
+  // it holds the position ALONG the dash, so across_enu holds the dash's
+  // direction and row 0 of the whitening its sd; row 1 is zero (the dash's
+  // points hold the height). The same residual; never a cross-track
+  // discrepancy.
+  bool along_track = false;
 };
 
 // S such that S C S^T = I for the 2 x 2 covariance of [across, up]:

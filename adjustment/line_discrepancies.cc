@@ -68,6 +68,8 @@ std::vector<CrossingDiscrepancy> LineDiscrepancies(const State& state,
   const double start = state.correction.KnotTime(0);
   std::map<int, std::vector<const State::Line*>> bins;
   for (const State::Line& line : state.lines) {
+    // A dash's centre measures the along-track error, not this one.
+    if (line.point.along_track) continue;
     bins[static_cast<int>(std::floor((line.point.time - start) / bin_s))]
         .push_back(&line);
   }

@@ -31,12 +31,15 @@ std::set<int64_t> SkippedExposureIds(StageResults* results) {
 }
 
 // The times of the line control points that hold the position across
-// their line (not the height alone), sorted.
+// their line (not the height alone, not a dash's along-track position),
+// sorted.
 std::vector<double> CrossTrackTimes(
     const std::vector<LineControlPoint>& control) {
   std::vector<double> times;
   for (const LineControlPoint& c : control) {
-    if (c.sqrt_information.row(0).norm() > 0.0) times.push_back(c.time);
+    if (!c.along_track && c.sqrt_information.row(0).norm() > 0.0) {
+      times.push_back(c.time);
+    }
   }
   std::sort(times.begin(), times.end());
   times.erase(std::unique(times.begin(), times.end()), times.end());

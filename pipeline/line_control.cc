@@ -17,6 +17,7 @@
 
 #include "pipeline/stages.h"
 #include "reconstruction/road_lines.h"
+#include "registration/dash_matcher.h"
 #include "registration/line_matcher.h"
 #include "registration/line_offset.h"
 #include "survey/math_util.h"
@@ -224,6 +225,124 @@ LineControlPoint ControlPointOf(const ReconstructedLinePoint& p, double time,
   return c;
 }
 
+// A dash's two ends each lie this far from where the database's ends would
+// put them, beyond the reconstruction's covariance (the paint's blur and
+// wear; dash_matcher.h): the centre's sd from the ends alone is this over
+// sqrt(2). Measured on rendered surveys with the true trajectory: whole
+// dashes' centres lie 2 cm (sd) from the database's.
+constexpr double kDashEndSigmaM = 0.03;
+// The along-track gate of a dash: max(this, kLineGateSigmas x the posterior
+// sd of the zebra-corrected trajectory there).
+constexpr double kMinDashGateM = 0.3;
+
+// The whole dashes among the line points (a lane_dashed line whose kept
+// point matches all lie on one database dash), matched to the database's
+// dashes along the track (registration/dash_matcher.h): one along-track
+// control point at each dash's centre, appended to `control` and `rows`;
+// returns how many.
+int AddDashControl(const std::vector<ReconstructedLinePoint>& points,
+                   const LinePointsEnu& line_points,
+                   const std::vector<LinePointMatch>& matches,
+                   const std::vector<DatabaseLineEnu>& database,
+                   const AdjustmentResult& zebra_result,
+                   const AdjustmentOptions& options,
+                   std::vector<LineControlPoint>* control,
+                   std::vector<LineMatch>* rows) {
+  const DashMatchOptions dash_options;
+  const std::vector<int> db_dashes = DatabaseDashes(database, dash_options);
+  if (db_dashes.empty()) return 0;
+  // The database line each reconstructed line's kept points agree on, or
+  // -1 when they split.
+  std::map<int64_t, int> db_line_of;
+  for (const LinePointMatch& m : matches) {
+    const int64_t id = line_points.enu[m.point].line_id;
+    const auto [it, inserted] = db_line_of.emplace(id, m.db_line);
+    if (!inserted && it->second != m.db_line) it->second = -1;
+  }
+  // First and last point (indices into line_points) of each dashed line.
+  std::map<int64_t, std::pair<int, int>> ends;
+  for (size_t i = 0; i < line_points.enu.size(); ++i) {
+    const ReconstructedLinePoint& p = points[line_points.source[i]];
+    if (p.type != RoadLineType::kLaneDashed) continue;
+    const auto [it, inserted] = ends.emplace(
+        p.line_id, std::make_pair(static_cast<int>(i), static_cast<int>(i)));
+    if (inserted) continue;
+    auto& [first, last] = it->second;
+    if (p.point < points[line_points.source[first]].point) {
+      first = static_cast<int>(i);
+    }
+    if (p.point > points[line_points.source[last]].point) {
+      last = static_cast<int>(i);
+    }
+  }
+  std::vector<ReconstructedDashEnu> dashes;
+  std::vector<std::pair<int, int>> dash_ends;
+  std::vector<int> dash_db_line;
+  for (const auto& [id, e] : ends) {
+    const auto db = db_line_of.find(id);
+    if (db == db_line_of.end() || db->second < 0 || e.first == e.second) {
+      continue;
+    }
+    const double sd = PosteriorSdAt(zebra_result, line_points.time_of[e.first]);
+    dashes.push_back({line_points.enu[e.first].p_enu,
+                      line_points.enu[e.second].p_enu,
+                      std::max(kMinDashGateM, kLineGateSigmas * sd)});
+    dash_ends.push_back(e);
+    dash_db_line.push_back(db->second);
+  }
+  std::vector<DashMatch> dash_matches;
+  std::map<int, int> seen_of_db_dash;
+  for (const DashMatch& m :
+       MatchDashes(dashes, database, db_dashes, dash_options)) {
+    // The nearest database dash must be the one the points lie on.
+    if (m.db_line != dash_db_line[m.dash]) continue;
+    dash_matches.push_back(m);
+    ++seen_of_db_dash[m.db_line];
+  }
+  for (const DashMatch& m : dash_matches) {
+    const auto [first, last] = dash_ends[m.dash];
+    const ReconstructedLinePoint& a = points[line_points.source[first]];
+    const ReconstructedLinePoint& b = points[line_points.source[last]];
+    const Pose& pose = line_points.pose_of[first];
+    const DatabaseLineEnu& line = database[m.db_line];
+    LineControlPoint c;
+    c.time = line_points.time_of[first];
+    c.p_body = 0.5 * (a.p_body + b.p_body);
+    c.db_point_enu = m.db_centre_enu;
+    c.across_enu = m.along_enu;
+    c.along_enu = Eigen::Vector3d(-m.along_enu.y(), m.along_enu.x(), 0.0);
+    c.along_track = true;
+    // The database dash's error is shared by every exposure that saw it.
+    const double db_sigma =
+        std::sqrt(static_cast<double>(seen_of_db_dash[m.db_line])) *
+        std::max(line.sigma_xy_m, options.min_database_sigma_m);
+    const Eigen::Matrix3d R = pose.q_enu_body.toRotationMatrix();
+    const Eigen::Matrix3d covariance_enu =
+        R * (0.25 * (a.covariance_body + b.covariance_body)) * R.transpose();
+    const double variance = m.along_enu.dot(covariance_enu * m.along_enu) +
+                            0.5 * kDashEndSigmaM * kDashEndSigmaM +
+                            db_sigma * db_sigma;
+    c.sqrt_information.setZero();
+    c.sqrt_information(0, 0) = 1.0 / std::sqrt(variance);
+    control->push_back(c);
+    LineMatch row;
+    row.exposure_id = a.exposure_id;
+    row.line_id = a.line_id;
+    row.point = -1;
+    row.type = a.type;
+    row.db_line = line.id;
+    row.across_enu = m.along_enu.head<2>();
+    row.distance_m = m.offset_m;
+    row.constrains_across = false;
+    row.along = true;
+    rows->push_back(row);
+  }
+  LOG(INFO) << "road lines: " << dash_matches.size() << " of " << dashes.size()
+            << " dashes on a database dash matched along the track ("
+            << db_dashes.size() << " dashes in the database)";
+  return static_cast<int>(dash_matches.size());
+}
+
 // Logs the line control per stretch of stretch_s seconds.
 void LogLineControl(size_t used, size_t reconstructed, double stretch_s,
                     const std::map<int, std::array<int, 3>>& stretches) {
@@ -236,7 +355,10 @@ void LogLineControl(size_t used, size_t reconstructed, double stretch_s,
            << s[2] << "]";
   }
   LOG(INFO) << report.str();
-  LOG(INFO) << "road lines control cross-track and height between crossings";
+  int along = 0;
+  for (const auto& [k, s] : stretches) along += s[2];
+  LOG(INFO) << "road lines control cross-track and height between crossings"
+            << (along > 0 ? "; whole dashes the along-track position" : "");
 }
 
 }  // namespace
@@ -330,6 +452,18 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     rows.push_back({p.exposure_id, p.line_id, p.point, p.type, line.id,
                     m.across_enu.head<2>(), m.distance_m, m.height_m,
                     cross_track});
+  }
+  // Along the track: whole dashes, once the crossings corrected the
+  // trajectory (without them its along-track error is unbounded, and a
+  // dash period off would match the next dash).
+  if (zebra_result.summary.corrected) {
+    const size_t first_dash = control.size();
+    AddDashControl(points, line_points, matches, database, zebra_result,
+                   options, &control, &rows);
+    for (size_t i = first_dash; i < control.size(); ++i) {
+      stretches[static_cast<int>(
+          std::floor((control[i].time - start_time) / stretch_s))][2] += 1;
+    }
   }
   LogLineControl(matches.size(), points.size(), stretch_s, stretches);
   if (results_folder.empty()) return control;

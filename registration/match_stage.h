@@ -116,6 +116,18 @@ struct RematchOptions {
   // vertex matches).
   double max_line_drift_sd_m = 0.175;
   double max_line_bracket_gap_s = 8.0;
+  // After an adjustment with crossings and road lines: its posterior sd
+  // gates the search, and across the track that sd holds only where
+  // something measured the position: an observation is searched within
+  // this distance travelled of a road-line point that held the cross-track
+  // position or of an exposure matched to a crossing kept as control (in
+  // practice: lines seen in the same images), or between two such times as
+  // above. Where lines are painted but none matched, a multipath switch the
+  // error model never saw may have put them beyond the lines' gate, and the
+  // trajectory a band period off with a small sd (geometry seed 435: 0.75 m
+  // across, 4 cm sd, 1.2 s past the last line point; 8 wrong vertex matches
+  // with 12 m). Without road lines the gate is the error model's alone.
+  double max_cross_track_control_gap_m = 5.0;
   std::string Check() const;
 };
 struct RematchSummary {

@@ -41,6 +41,12 @@ std::string RematchOptions::Check() const {
     return "max_line_control_gap_m = " +
            std::to_string(max_line_control_gap_m) + ": must be finite and >= 0";
   }
+  if (!(max_cross_track_control_gap_m >= 0.0) ||
+      !std::isfinite(max_cross_track_control_gap_m)) {
+    return "max_cross_track_control_gap_m = " +
+           std::to_string(max_cross_track_control_gap_m) +
+           ": must be finite and >= 0";
+  }
   if (!(max_line_drift_sd_m >= 0.0) || !std::isfinite(max_line_drift_sd_m)) {
     return "max_line_drift_sd_m = " + std::to_string(max_line_drift_sd_m) +
            ": must be finite and >= 0";
@@ -141,6 +147,32 @@ bool BoundedByLines(const AdjustmentRecord& record,
          CrossTrackDriftSd(record, gap_s) <= rematch.max_line_drift_sd_m;
 }
 
+// The times at which something measured the cross-track position of the
+// adjusted trajectory: the road lines' control points and the exposures
+// whose bands were matched to a crossing the adjustment kept; sorted.
+std::vector<double> CrossTrackControlTimes(const Survey& survey,
+                                           const RematchInput& first) {
+  std::vector<double> times;
+  if (first.line_control_times != nullptr) times = *first.line_control_times;
+  if (first.matches != nullptr) {
+    std::map<int64_t, double> time_of;
+    for (const Exposure& e : survey.exposures.exposures) {
+      time_of[e.exposure_id] = e.time;
+    }
+    for (const VertexMatch& m : *first.matches) {
+      const auto t = time_of.find(m.exposure_id);
+      if (t != time_of.end() &&
+          (first.rejected_crossings == nullptr ||
+           !first.rejected_crossings->count(m.crossing_id))) {
+        times.push_back(t->second);
+      }
+    }
+  }
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  return times;
+}
+
 // The second pass: the bands matched again on the survey as the adjustment
 // left it (its corrected trajectory), with the rematch gates. *bands_of:
 // the band ids of each observation (exposure, group).
@@ -189,6 +221,26 @@ MatchResult MatchOnAdjustedTrajectory(
     // first pass; across it, a band offset (a metre) lies far outside.
     tight.max_cross_track_m = rematch.cross_track_gate_m;
   } else {
+    // The gate is the adjusted trajectory's posterior sd, which holds
+    // across the track only where something measured it
+    // (RematchOptions::max_cross_track_control_gap_m). Whole dashes, which
+    // shrink the along-track sd and with it the radial gate, exposed this
+    // (seed 435).
+    const std::vector<double> times = CrossTrackControlTimes(survey, first);
+    const bool lines = first.line_control_times != nullptr &&
+                       !first.line_control_times->empty();
+    if (lines) {
+      input.observations.erase(
+          std::remove_if(input.observations.begin(), input.observations.end(),
+                         [&](const CrossingObservation& o) {
+                           return !NearAny(
+                                      times, o.time_s, adjusted.trajectory,
+                                      rematch.max_cross_track_control_gap_m) &&
+                                  !BoundedByLines(*first.adjustment, times,
+                                                  o.time_s, rematch);
+                         }),
+          input.observations.end());
+    }
     tight.max_drift_m = rematch.gate_m;
     tight.sd_gate_factor = rematch.sd_gate_factor;
     tight.max_heading_error_rad = rematch.max_heading_error_rad;

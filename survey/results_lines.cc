@@ -138,7 +138,9 @@ void WriteLineMatches(const std::vector<LineMatch>& matches,
   csv.Comment(
       "road-line points matched to database lines (issue 9); each constrains "
       "the position across the line (across_e, across_n) and the height, "
-      "never along the line");
+      "never along the line; a whole dash's centre (point -1, constrains "
+      "along) the position along its database dash (across_e, across_n then "
+      "hold the dash's direction, distance_m the offset along it)");
   csv.Header(LineMatchColumns());
   for (const LineMatch& m : matches) {
     csv.Add(m.exposure_id)
@@ -150,7 +152,8 @@ void WriteLineMatches(const std::vector<LineMatch>& matches,
         .Add(m.across_enu.y())
         .Add(m.distance_m)
         .Add(m.height_m)
-        .Add(m.constrains_across ? "across+height" : "height");
+        .Add(m.along ? "along"
+                     : (m.constrains_across ? "across+height" : "height"));
     csv.EndRow();
   }
   file.Commit();
@@ -172,10 +175,12 @@ std::vector<LineMatch> ReadLineMatches(const std::string& path,
     m.distance_m = csv.GetDouble(row, "distance_m");
     m.height_m = csv.GetDouble(row, "height_m");
     const std::string& constrains = csv.GetString(row, "constrains");
-    if (constrains != "across+height" && constrains != "height") {
-      csv.Fail(row, "constrains must be across+height or height");
+    if (constrains != "across+height" && constrains != "height" &&
+        constrains != "along") {
+      csv.Fail(row, "constrains must be across+height, height or along");
     }
     m.constrains_across = constrains == "across+height";
+    m.along = constrains == "along";
     matches.push_back(m);
   }
   return matches;
@@ -202,7 +207,8 @@ json LineControlJson(const LineControlRecord& record) {
       "a road line constrains the position across itself and the height, "
       "never along itself: lane lines control cross-track and height; stop "
       "lines the height only (the zebra crossings beside them hold the "
-      "along-track position)";
+      "along-track position); a dash seen whole, matched to a database "
+      "dash, the position along the track";
   json list = json::array();
   for (const LineControlStretch& s : record.stretches) {
     json controlled = json::array();

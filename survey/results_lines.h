@@ -61,6 +61,10 @@ struct LineMatch {
   // Across the line and the height (a line along the vehicle), or the
   // height only (a line across the road: a stop line).
   bool constrains_across = true;
+  // A whole dash's centre (point -1) on its database dash's: the position
+  // along the dash (across_enu then holds the dash's direction, distance_m
+  // the offset along it); constrains_across is false.
+  bool along = false;
 };
 void WriteLineMatches(const std::vector<LineMatch>& matches,
                       const std::string& path);

@@ -163,6 +163,116 @@ TEST_F(MatchLinesForAdjustmentTest, WithoutZebraControlTheLinesFindTheOffset) {
   }
 }
 
+// A dashed line 5.25 m to the left drawn dash by dash (3 m every 8 m), seen
+// from every exposure between 4 and 12 m ahead: a dash inside that range is
+// whole, reconstructed 0.2 m inside each painted end; one cut by the range
+// by a metre or more is shorter. Returns how many whole dashes were seen.
+int AddDashes(AdjustmentData* data, std::vector<ReconstructedLinePoint>* points,
+              double north_m) {
+  for (double east = 0.0; east < 260.0; east += 8.0) {
+    RoadmarkLine db;
+    db.id = "dash-" + std::to_string(static_cast<int>(east));
+    db.type = "lane_dashed";
+    db.sigma_xy_m = 0.03;
+    db.sigma_z_m = 0.03;
+    for (double x : {east, east + 3.0}) {
+      db.points.push_back(
+          data->frame.GeodeticFromEnu(Eigen::Vector3d(x, north_m, 0.0)));
+    }
+    data->roadmarks.lines.push_back(db);
+  }
+  int whole = 0;
+  int64_t line_id = 100000;
+  for (const Exposure& exposure : data->exposures.exposures) {
+    const Pose pose = TruePose(exposure.time);
+    const double near = pose.p_enu.x() + 4.0, far = pose.p_enu.x() + 12.0;
+    for (double east = 0.0; east < 260.0; east += 8.0) {
+      const double start = std::max(east, near);
+      const double end = std::min(east + 3.0, far);
+      const double cut = (start - east) + (east + 3.0 - end);
+      if (end - start < 1.0 || (cut > 0.0 && cut < 1.0)) continue;
+      if (cut == 0.0) ++whole;
+      const double a = start + (start == east ? 0.2 : 0.0);
+      const double b = end - (end == east + 3.0 ? 0.2 : 0.0);
+      ++line_id;
+      for (int k = 0; k < 4; ++k) {
+        ReconstructedLinePoint p;
+        p.exposure_id = exposure.exposure_id;
+        p.line_id = line_id;
+        p.type = RoadLineType::kLaneDashed;
+        p.point = k;
+        p.p_body = pose.T_enu_body().inverse() *
+                   Eigen::Vector3d(a + (b - a) * k / 3.0, north_m, 0.0);
+        p.covariance_body = Eigen::Matrix3d::Identity() * 1e-4;
+        points->push_back(p);
+      }
+    }
+  }
+  return whole;
+}
+
+// Whole dashes hold the along-track position: one control point at each
+// whole dash's centre, on its database dash's centre along the dash; cut
+// dashes give none; the files say so.
+TEST_F(MatchLinesForAdjustmentTest, WholeDashesControlTheAlongTrackPosition) {
+  const int whole = AddDashes(&data_, &points_, 5.25 + 3.5);
+  ASSERT_GT(whole, 20);
+  std::vector<std::string> warnings;
+  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
+      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  int along = 0;
+  for (const LineControlPoint& c : control) {
+    if (!c.along_track) continue;
+    ++along;
+    // The centre placed with the true pose lies on the database dash's
+    // centre along the dash (east), whatever the 0.2 m inset of its ends.
+    const Eigen::Vector3d p_enu = TruePose(c.time).T_enu_body() * c.p_body;
+    EXPECT_NEAR(std::abs(c.across_enu.x()), 1.0, 1e-6);
+    EXPECT_NEAR((p_enu - c.db_point_enu).dot(c.across_enu), 0.0, 1e-3);
+    // Along only: the height is the dash points' to hold.
+    EXPECT_GT(c.sqrt_information(0, 0), 0.0);
+    EXPECT_EQ(c.sqrt_information.row(1).norm(), 0.0);
+  }
+  EXPECT_EQ(along, whole);
+  int rows = 0;
+  for (const LineMatch& row :
+       ReadLineMatches(folder_.Path(kLineMatchesFile), kLineMatchesFile)) {
+    if (!row.along) continue;
+    ++rows;
+    EXPECT_EQ(row.point, -1);
+    EXPECT_NEAR(row.distance_m, 0.0, 1e-3);
+  }
+  EXPECT_EQ(rows, whole);
+  int stretch_points = 0;
+  for (const LineControlStretch& s :
+       ReadLineControl(folder_.Path(kLineControlFile), kLineControlFile)
+           .stretches) {
+    stretch_points += s.along_track_points;
+  }
+  EXPECT_EQ(stretch_points, whole);
+}
+
+// The zebra-corrected trajectory 0.5 m behind along the track, its
+// posterior sd 2 cm: a dash that far from where it says is not matched
+// (its gate is 0.3 m); nor without zebra control at all.
+TEST_F(MatchLinesForAdjustmentTest, NoDashOutsideTheAlongTrackGate) {
+  AddDashes(&data_, &points_, 5.25 + 3.5);
+  for (Pose& pose : zebra_.corrected_poses) pose.p_enu.x() -= 0.5;
+  std::vector<std::string> warnings;
+  for (const LineControlPoint& c :
+       MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_, &points_,
+                               folder_.Path(), &warnings)) {
+    EXPECT_FALSE(c.along_track);
+  }
+  zebra_.summary.corrected = false;
+  for (Pose& pose : zebra_.corrected_poses) pose.p_enu.x() += 0.5;
+  for (const LineControlPoint& c :
+       MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_, &points_,
+                               folder_.Path(), &warnings)) {
+    EXPECT_FALSE(c.along_track);
+  }
+}
+
 TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
   std::vector<std::string> warnings;
   EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,

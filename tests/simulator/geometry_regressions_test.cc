@@ -74,5 +74,21 @@ TEST(GeometryRegressions, Seed969ARejectedCrossingIsNotMatchedAgain) {
   EXPECT_LT(r.h_after_m, 0.4) << r.Line();
 }
 
+// A 0.9 m multipath switch 1.2 s after the last road-line point that held
+// the cross-track position, before the last crossing: the adjusted
+// trajectory is 0.75 m off across there with a posterior sd of 4 cm. Once
+// whole dashes held it along the track, the radial gate of the pass on the
+// crossings shrank from 0.75 to 0.43 m and let the crossing in one band
+// off (8 wrong vertex matches); that pass now searches only where lines or
+// kept crossings measured the position across the track.
+TEST(GeometryRegressions, Seed435NoSearchPastTheLastCrossTrackControl) {
+  const GeometryRunResult r = RunSeed(435);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_GE(r.crossings_matched, 3) << r.Line();
+  EXPECT_FALSE(r.worse_position) << r.Line();
+}
+
 }  // namespace
 }  // namespace zebrageo::support

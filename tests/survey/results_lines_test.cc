@@ -57,7 +57,7 @@ TEST(ReconstructedLines, WriteThenReadIsExact) {
 
 TEST(LineMatches, WriteThenReadIsExact) {
   TemporaryFolder folder;
-  std::vector<LineMatch> matches(2);
+  std::vector<LineMatch> matches(3);
   matches[0].exposure_id = 17;
   matches[0].line_id = 3;
   matches[0].point = 5;
@@ -69,10 +69,18 @@ TEST(LineMatches, WriteThenReadIsExact) {
   matches[1].type = RoadLineType::kStopLine;
   matches[1].db_line = "S1";
   matches[1].constrains_across = false;
+  // A dash's centre: along its database dash.
+  matches[2].point = -1;
+  matches[2].type = RoadLineType::kLaneDashed;
+  matches[2].db_line = "D4";
+  matches[2].across_enu = Eigen::Vector2d(0.8, 0.6);
+  matches[2].distance_m = 0.125;
+  matches[2].constrains_across = false;
+  matches[2].along = true;
   const std::string path = folder.Path(kLineMatchesFile);
   WriteLineMatches(matches, path);
   const std::vector<LineMatch> read = ReadLineMatches(path, kLineMatchesFile);
-  ASSERT_EQ(read.size(), 2u);
+  ASSERT_EQ(read.size(), 3u);
   for (size_t i = 0; i < read.size(); ++i) {
     EXPECT_EQ(read[i].exposure_id, matches[i].exposure_id);
     EXPECT_EQ(read[i].line_id, matches[i].line_id);
@@ -83,6 +91,7 @@ TEST(LineMatches, WriteThenReadIsExact) {
     EXPECT_EQ(read[i].distance_m, matches[i].distance_m);
     EXPECT_EQ(read[i].height_m, matches[i].height_m);
     EXPECT_EQ(read[i].constrains_across, matches[i].constrains_across);
+    EXPECT_EQ(read[i].along, matches[i].along);
   }
 }
 
@@ -92,7 +101,7 @@ TEST(LineMatches, ReaderRejectsUnknownConstraints) {
       "m.csv",
       "exposure_id,line_id,point,type,db_line,across_e,across_n,distance_m,"
       "height_m,constrains\n"
-      "1,2,3,lane_solid,L1,1,0,0.1,0,along\n");
+      "1,2,3,lane_solid,L1,1,0,0.1,0,sideways\n");
   EXPECT_THAT(ErrorOf([&] { ReadLineMatches(path, kLineMatchesFile); }),
               HasSubstr("line_matches.csv:2: constrains must be"));
 }

@@ -1,0 +1,106 @@
+#include "registration/dash_matcher.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace zebrageo {
+namespace {
+
+// Horizontal length of a polyline.
+double HorizontalLength(const std::vector<Eigen::Vector3d>& points) {
+  double length = 0.0;
+  for (size_t i = 1; i < points.size(); ++i) {
+    length += (points[i] - points[i - 1]).head<2>().norm();
+  }
+  return length;
+}
+
+bool NamesDash(const std::string& type) {
+  return type.find("dash") != std::string::npos;
+}
+
+}  // namespace
+
+std::string DashMatchOptions::Check() const {
+  std::ostringstream e;
+  if (!(max_dash_length_m > 0.0)) {
+    e << "max_dash_length_m = " << max_dash_length_m << ": must be positive";
+  } else if (!(min_length_difference_m < max_length_difference_m)) {
+    e << "min_length_difference_m = " << min_length_difference_m
+      << ": must be below max_length_difference_m";
+  } else if (!(max_across_m > 0.0)) {
+    e << "max_across_m = " << max_across_m << ": must be positive";
+  } else if (!(min_separation_ratio >= 1.0)) {
+    e << "min_separation_ratio = " << min_separation_ratio
+      << ": must be at least 1";
+  }
+  return e.str();
+}
+
+std::vector<int> DatabaseDashes(const std::vector<DatabaseLineEnu>& database,
+                                const DashMatchOptions& options) {
+  std::vector<int> dashes;
+  for (size_t i = 0; i < database.size(); ++i) {
+    const DatabaseLineEnu& line = database[i];
+    if (!NamesDash(line.type) || line.points.size() < 2) continue;
+    const double length = HorizontalLength(line.points);
+    if (length > 0.0 && length <= options.max_dash_length_m) {
+      dashes.push_back(static_cast<int>(i));
+    }
+  }
+  return dashes;
+}
+
+std::vector<DashMatch> MatchDashes(
+    const std::vector<ReconstructedDashEnu>& dashes,
+    const std::vector<DatabaseLineEnu>& database,
+    const std::vector<int>& db_dashes, const DashMatchOptions& options) {
+  std::vector<DashMatch> matches;
+  for (size_t d = 0; d < dashes.size(); ++d) {
+    const ReconstructedDashEnu& dash = dashes[d];
+    const Eigen::Vector3d centre = 0.5 * (dash.first_enu + dash.last_enu);
+    const double length = (dash.last_enu - dash.first_enu).head<2>().norm();
+    // The nearest database dash centre, and the distance to the next one.
+    int best = -1;
+    double best_distance = std::numeric_limits<double>::infinity();
+    double second_distance = best_distance;
+    for (int index : db_dashes) {
+      const DatabaseLineEnu& line = database[index];
+      const Eigen::Vector3d db_centre =
+          0.5 * (line.points.front() + line.points.back());
+      const double distance = (centre - db_centre).head<2>().norm();
+      if (distance < best_distance) {
+        second_distance = best_distance;
+        best_distance = distance;
+        best = index;
+      } else {
+        second_distance = std::min(second_distance, distance);
+      }
+    }
+    if (best < 0 ||
+        second_distance < options.min_separation_ratio * best_distance) {
+      continue;
+    }
+    const DatabaseLineEnu& line = database[best];
+    const Eigen::Vector3d db_centre =
+        0.5 * (line.points.front() + line.points.back());
+    Eigen::Vector3d along = line.points.back() - line.points.front();
+    along.z() = 0.0;
+    along.normalize();
+    const Eigen::Vector3d across(-along.y(), along.x(), 0.0);
+    const Eigen::Vector3d offset = centre - db_centre;
+    const double length_difference = length - HorizontalLength(line.points);
+    if (std::abs(offset.dot(across)) > options.max_across_m ||
+        std::abs(offset.dot(along)) > dash.gate_m ||
+        length_difference < options.min_length_difference_m ||
+        length_difference > options.max_length_difference_m) {
+      continue;
+    }
+    matches.push_back({static_cast<int>(d), best, db_centre, along,
+                       offset.dot(along), length_difference});
+  }
+  return matches;
+}
+
+}  // namespace zebrageo
