@@ -37,6 +37,36 @@ bool RunsAcrossRows(const std::vector<cv::Point>& chain) {
   return std::abs(d.y) >= 2 * std::abs(d.x);
 }
 
+// Rows of paint beyond a chain's end pixel `end`, away from `inner` (a
+// chain pixel a few steps in), in the bright mask: what the thinning took
+// off that end. Zhang-Suen's thinning is not symmetric (its first
+// sub-iteration takes the south and east boundary pixels), so a dash came
+// out about a pixel shorter at one end than at the other: on rendered
+// surveys its near end lay 0.21 m inside the paint and its far end
+// 0.18 m, which put the dash's centre, an along-track control point
+// (registration/dash_matcher.h), 1.5 cm forward.
+int ThinnedAwayRows(const cv::Mat& bright, const cv::Point& end,
+                    const cv::Point& inner) {
+  constexpr int kMaxRows = 10;
+  const int dy = end.y > inner.y ? 1 : (end.y < inner.y ? -1 : 0);
+  if (dy == 0) return 0;
+  int x = end.x;
+  int rows = 0;
+  for (int y = end.y + dy; rows < kMaxRows; y += dy) {
+    int next = -1;
+    for (int dx : {0, -1, 1}) {
+      if (IsSet(bright, x + dx, y)) {
+        next = x + dx;
+        break;
+      }
+    }
+    if (next < 0) break;
+    x = next;
+    ++rows;
+  }
+  return rows;
+}
+
 // A triangulated chain pixel.
 struct ChainPoint {
   int index = 0;  // in the chain
@@ -71,6 +101,25 @@ void AverageVertices(const std::vector<ChainPoint>& points,
     line->points_body.push_back(sum / n);
     line->covariances_body.push_back(covariance / n / effective);
   }
+}
+
+// Moves the end vertices of a lane line outwards by the rows the thinning
+// took off each end of its chain (ThinnedAwayRows; gsd metres per row, the
+// line running along the columns), so both ends lie alike inside the
+// paint (by the vertex averaging's one-sided window).
+void RestoreThinnedEnds(const cv::Mat& bright,
+                        const std::vector<cv::Point>& chain, double gsd,
+                        RoadLine3d* line) {
+  std::vector<Eigen::Vector3d>& p = line->points_body;
+  if (p.size() < 2 || chain.size() < 4) return;
+  const size_t k = 3;
+  const int front = ThinnedAwayRows(bright, chain.front(), chain[k]);
+  const int back =
+      ThinnedAwayRows(bright, chain.back(), chain[chain.size() - 1 - k]);
+  const Eigen::Vector3d out_front = (p.front() - p[1]).normalized();
+  const Eigen::Vector3d out_back = (p.back() - p[p.size() - 2]).normalized();
+  p.front() += front * gsd * out_front;
+  p.back() += back * gsd * out_back;
 }
 
 double PolylineLength(const std::vector<Eigen::Vector3d>& points) {
@@ -227,6 +276,7 @@ void StereoLineExtractor::LaneLines(const cv::Mat& left, const cv::Mat& right,
         DropCollinearPoints(chain, options_.collinear_tolerance_px, spacing_px),
         options_, &line);
     if (line.points_body.size() < 2) continue;
+    RestoreThinnedEnds(bright[0], chain, gsd, &line);
     const int margin = options_.median_window_px;
     const bool ends_seen = InsideValid(valid, chain.front(), margin) &&
                            InsideValid(valid, chain.back(), margin);

@@ -9,10 +9,10 @@
 // then places the vehicle along the track too.
 //
 // The reconstruction finds a dash's ends a little inside the paint (the end
-// vertex averages the points within a few pixels of the end; the paint's
-// blur): the same at both ends, so the dash's CENTRE (the mid-point of its
-// two ends) is the observation, and its length tells a whole dash from one
-// cut by an occlusion or the image border.
+// vertex averages the points within a few pixels of the end): alike at
+// both ends, so the dash's CENTRE (the mid-point of its two ends) is the
+// observation, and its length tells a whole dash from one cut by an
+// occlusion or the image border.
 //
 // A dash is matched to the database dash whose centre is nearest when
 //   - its length minus the database dash's lies in [min_length_difference_m,
@@ -41,9 +41,10 @@ namespace zebrageo {
 struct DashMatchOptions {
   double max_dash_length_m = 6.5;
   // Reconstructed minus database length: a whole dash seen by the road-line
-  // stage is 0.3 to 0.5 m shorter than painted (its ends lie inside the
-  // paint by about 0.2 m each); one cut by a vehicle or the image border is
-  // shorter by more.
+  // stage is about 0.2 m shorter than painted (its ends lie about 0.1 m
+  // inside the paint, the end vertices averaging the points within a few
+  // pixels of them); one cut by a vehicle or the image border is shorter by
+  // a metre or more.
   double min_length_difference_m = -0.6;
   double max_length_difference_m = 0.15;
   double max_across_m = 0.4;
