@@ -1,5 +1,7 @@
 #include "registration/dash_matcher.h"
 
+#include <glog/logging.h>
+
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -80,6 +82,8 @@ std::vector<DashMatch> MatchDashes(
     }
     if (best < 0 ||
         second_distance < options.min_separation_ratio * best_distance) {
+      VLOG(2) << "dash " << d << ": the nearest database dash is "
+              << best_distance << " m away, the next " << second_distance;
       continue;
     }
     const DatabaseLineEnu& line = database[best];
@@ -95,6 +99,10 @@ std::vector<DashMatch> MatchDashes(
         std::abs(offset.dot(along)) > dash.gate_m ||
         length_difference < options.min_length_difference_m ||
         length_difference > options.max_length_difference_m) {
+      VLOG(2) << "dash " << d << " not matched to " << line.id << ": "
+              << offset.dot(along) << " m along (gate " << dash.gate_m << "), "
+              << offset.dot(across) << " m across, length " << length_difference
+              << " m from the database's";
       continue;
     }
     matches.push_back({static_cast<int>(d), best, db_centre, along,
