@@ -523,6 +523,10 @@ TEST(RematchOptions, CrossTrackGateUnderHalfABand) {
   options = RematchOptions();
   options.max_line_control_gap_m = -1.0;
   EXPECT_NE(options.Check().find("max_line_control_gap_m"), std::string::npos);
+  options = RematchOptions();
+  options.max_cross_track_control_gap_m = std::nan("");
+  EXPECT_NE(options.Check().find("max_cross_track_control_gap_m"),
+            std::string::npos);
   MatchOptions match;
   match.max_cross_track_m = -1.0;
   EXPECT_NE(match.Check().find("max_cross_track_m"), std::string::npos);
