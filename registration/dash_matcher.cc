@@ -58,24 +58,26 @@ std::vector<DashMatch> MatchDashes(
     const std::vector<ReconstructedDashEnu>& dashes,
     const std::vector<DatabaseLineEnu>& database,
     const std::vector<int>& db_dashes, const DashMatchOptions& options) {
+  std::vector<Eigen::Vector3d> db_centres;
+  for (int index : db_dashes) {
+    const DatabaseLineEnu& line = database[index];
+    db_centres.push_back(0.5 * (line.points.front() + line.points.back()));
+  }
   std::vector<DashMatch> matches;
   for (size_t d = 0; d < dashes.size(); ++d) {
     const ReconstructedDashEnu& dash = dashes[d];
     const Eigen::Vector3d centre = 0.5 * (dash.first_enu + dash.last_enu);
     const double length = (dash.last_enu - dash.first_enu).head<2>().norm();
     // The nearest database dash centre, and the distance to the next one.
-    int best = -1;
+    int best = -1;  // index into db_dashes
     double best_distance = std::numeric_limits<double>::infinity();
     double second_distance = best_distance;
-    for (int index : db_dashes) {
-      const DatabaseLineEnu& line = database[index];
-      const Eigen::Vector3d db_centre =
-          0.5 * (line.points.front() + line.points.back());
-      const double distance = (centre - db_centre).head<2>().norm();
+    for (size_t k = 0; k < db_dashes.size(); ++k) {
+      const double distance = (centre - db_centres[k]).head<2>().norm();
       if (distance < best_distance) {
         second_distance = best_distance;
         best_distance = distance;
-        best = index;
+        best = static_cast<int>(k);
       } else {
         second_distance = std::min(second_distance, distance);
       }
@@ -86,9 +88,8 @@ std::vector<DashMatch> MatchDashes(
               << best_distance << " m away, the next " << second_distance;
       continue;
     }
-    const DatabaseLineEnu& line = database[best];
-    const Eigen::Vector3d db_centre =
-        0.5 * (line.points.front() + line.points.back());
+    const DatabaseLineEnu& line = database[db_dashes[best]];
+    const Eigen::Vector3d& db_centre = db_centres[best];
     Eigen::Vector3d along = line.points.back() - line.points.front();
     along.z() = 0.0;
     along.normalize();
@@ -105,7 +106,7 @@ std::vector<DashMatch> MatchDashes(
               << " m from the database's";
       continue;
     }
-    matches.push_back({static_cast<int>(d), best, db_centre, along,
+    matches.push_back({static_cast<int>(d), db_dashes[best], db_centre, along,
                        offset.dot(along), length_difference});
   }
   return matches;

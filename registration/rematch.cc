@@ -68,6 +68,22 @@ std::string RematchOptions::Check() const {
 
 namespace {
 
+// The times of the exposures `exposure_ids` (those in `exposures`) and
+// `more`, sorted, each once.
+std::vector<double> SortedExposureTimes(
+    const std::vector<int64_t>& exposure_ids, const ExposureTable& exposures,
+    std::vector<double> more) {
+  std::map<int64_t, double> time_of;
+  for (const Exposure& e : exposures.exposures) time_of[e.exposure_id] = e.time;
+  for (int64_t id : exposure_ids) {
+    const auto t = time_of.find(id);
+    if (t != time_of.end()) more.push_back(t->second);
+  }
+  std::sort(more.begin(), more.end());
+  more.erase(std::unique(more.begin(), more.end()), more.end());
+  return more;
+}
+
 // "" when the adjustment (its adjustment.json, survey/results_adjustment.h,
 // null when missing) can gate the second pass, else why not.
 std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
@@ -152,25 +168,19 @@ bool BoundedByLines(const AdjustmentRecord& record,
 // whose bands were matched to a crossing the adjustment kept; sorted.
 std::vector<double> CrossTrackControlTimes(const Survey& survey,
                                            const RematchInput& first) {
-  std::vector<double> times;
-  if (first.line_control_times != nullptr) times = *first.line_control_times;
+  std::vector<int64_t> ids;
   if (first.matches != nullptr) {
-    std::map<int64_t, double> time_of;
-    for (const Exposure& e : survey.exposures.exposures) {
-      time_of[e.exposure_id] = e.time;
-    }
     for (const VertexMatch& m : *first.matches) {
-      const auto t = time_of.find(m.exposure_id);
-      if (t != time_of.end() &&
-          (first.rejected_crossings == nullptr ||
-           !first.rejected_crossings->count(m.crossing_id))) {
-        times.push_back(t->second);
+      if (first.rejected_crossings == nullptr ||
+          !first.rejected_crossings->count(m.crossing_id)) {
+        ids.push_back(m.exposure_id);
       }
     }
   }
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  return times;
+  return SortedExposureTimes(ids, survey.exposures,
+                             first.line_control_times != nullptr
+                                 ? *first.line_control_times
+                                 : std::vector<double>());
 }
 
 // The second pass: the bands matched again on the survey as the adjustment
@@ -433,18 +443,11 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
 
 std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
                                      const ExposureTable& exposures) {
-  std::map<int64_t, double> time_of;
-  for (const Exposure& e : exposures.exposures) time_of[e.exposure_id] = e.time;
-  std::vector<double> times;
+  std::vector<int64_t> ids;
   for (const LineMatch& row : rows) {
-    const auto t = time_of.find(row.exposure_id);
-    if (row.constrains_across && t != time_of.end()) {
-      times.push_back(t->second);
-    }
+    if (row.constrains_across) ids.push_back(row.exposure_id);
   }
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  return times;
+  return SortedExposureTimes(ids, exposures, {});
 }
 
 std::vector<double> LineControlTimesIn(const std::string& results_folder,
