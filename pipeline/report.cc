@@ -173,6 +173,20 @@ bool RoadLinesControl(const json& road_lines, double t0, double t1) {
   return overlapping > 0 && 2 * controlled > overlapping;
 }
 
+// Whether whole lane-line dashes held the along-track position in a
+// stretch of line_control.json overlapping [t0, t1].
+bool DashesControl(const json& road_lines, double t0, double t1) {
+  if (!road_lines.is_object()) return false;
+  const double length = road_lines.value("stretch_s", 0.0);
+  for (const json& s : road_lines.value("stretches", json::array())) {
+    const double a = s.value("time0", 0.0);
+    if (a + length > t0 && a < t1 && s.value("along_track_points", 0) > 0) {
+      return true;
+    }
+  }
+  return false;
+}
+
 // Warnings: the survey's, the stages' (those the match and adjust stages
 // recorded in their files too, so that every warning they logged is here,
 // resumed stages included), and what the figures show. Marks the
@@ -214,14 +228,23 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
                                         s["start_time_s"].get<double>(),
                                         s["end_time_s"].get<double>());
     s["road_lines_control_cross_track_and_height"] = lines;
+    // The stretches of line_control.json are coarser than this one: dashes
+    // there may lie outside it.
+    const bool dashes =
+        lines && DashesControl(report->value("road_lines", json()),
+                               s["start_time_s"].get<double>(),
+                               s["end_time_s"].get<double>());
     std::ostringstream text;
     text.precision(0);
     text << std::fixed << "no control over " << s["length_m"].get<double>()
          << " m of trajectory (t = " << s["start_time_s"].get<double>()
          << " to " << s["end_time_s"].get<double>() << " s) by zebra crossings"
-         << (lines ? "; road lines control cross-track and height there, "
-                     "along-track is not controlled"
-                   : "");
+         << (!lines   ? ""
+             : dashes ? "; road lines control cross-track and height there, "
+                        "along-track only where whole dashes were matched "
+                        "(line_matches.csv, constrains along)"
+                      : "; road lines control cross-track and height there, "
+                        "along-track is not controlled");
     warnings.push_back(text.str());
   }
   if (data.adjustment.is_object() && data.adjustment.contains("sigma0") &&
