@@ -163,6 +163,24 @@ bool BoundedByLines(const AdjustmentRecord& record,
          CrossTrackDriftSd(record, gap_s) <= rematch.max_line_drift_sd_m;
 }
 
+// Drops the observations where nothing measured the cross-track position:
+// farther than gap_m travelled (on `trajectory`) from every one of the
+// sorted `times` and not between two of them that the error model bounds
+// (BoundedByLines).
+void KeepMeasuredAcross(const std::vector<double>& times, double gap_m,
+                        const Trajectory& trajectory,
+                        const AdjustmentRecord& record,
+                        const RematchOptions& rematch,
+                        std::vector<CrossingObservation>* observations) {
+  observations->erase(
+      std::remove_if(observations->begin(), observations->end(),
+                     [&](const CrossingObservation& o) {
+                       return !NearAny(times, o.time_s, trajectory, gap_m) &&
+                              !BoundedByLines(record, times, o.time_s, rematch);
+                     }),
+      observations->end());
+}
+
 // The times at which something measured the cross-track position of the
 // adjusted trajectory: the road lines' control points and the exposures
 // whose bands were matched to a crossing the adjustment kept; sorted.
@@ -215,17 +233,10 @@ MatchResult MatchOnAdjustedTrajectory(
     // their points, or between two where their own error model says it
     // cannot have moved by a band offset.
     const std::vector<double> none;
-    const std::vector<double>& times =
-        first.line_control_times != nullptr ? *first.line_control_times : none;
-    input.observations.erase(
-        std::remove_if(input.observations.begin(), input.observations.end(),
-                       [&](const CrossingObservation& o) {
-                         return !NearAny(times, o.time_s, adjusted.trajectory,
-                                         rematch.max_line_control_gap_m) &&
-                                !BoundedByLines(*first.adjustment, times,
-                                                o.time_s, rematch);
-                       }),
-        input.observations.end());
+    KeepMeasuredAcross(
+        first.line_control_times != nullptr ? *first.line_control_times : none,
+        rematch.max_line_control_gap_m, adjusted.trajectory, *first.adjustment,
+        rematch, &input.observations);
     // Road lines corrected the trajectory across the track and in height:
     // along-track and in heading it is the input's, searched as in the
     // first pass; across it, a band offset (a metre) lies far outside.
@@ -236,20 +247,12 @@ MatchResult MatchOnAdjustedTrajectory(
     // (RematchOptions::max_cross_track_control_gap_m). Whole dashes, which
     // shrink the along-track sd and with it the radial gate, exposed this
     // (seed 435).
-    const std::vector<double> times = CrossTrackControlTimes(survey, first);
-    const bool lines = first.line_control_times != nullptr &&
-                       !first.line_control_times->empty();
-    if (lines) {
-      input.observations.erase(
-          std::remove_if(input.observations.begin(), input.observations.end(),
-                         [&](const CrossingObservation& o) {
-                           return !NearAny(
-                                      times, o.time_s, adjusted.trajectory,
-                                      rematch.max_cross_track_control_gap_m) &&
-                                  !BoundedByLines(*first.adjustment, times,
-                                                  o.time_s, rematch);
-                         }),
-          input.observations.end());
+    if (first.line_control_times != nullptr &&
+        !first.line_control_times->empty()) {
+      KeepMeasuredAcross(CrossTrackControlTimes(survey, first),
+                         rematch.max_cross_track_control_gap_m,
+                         adjusted.trajectory, *first.adjustment, rematch,
+                         &input.observations);
     }
     tight.max_drift_m = rematch.gate_m;
     tight.sd_gate_factor = rematch.sd_gate_factor;
