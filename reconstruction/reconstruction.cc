@@ -490,6 +490,7 @@ ReconstructionSummary ReconstructSurvey(
   ReconstructionSummary summary;
   summary.message = options.Check();
   if (!summary.message.empty()) return summary;
+  PrepareImageCodecs();  // before the worker threads read images
   const Rig& rig = survey.rig;
   const std::vector<Exposure>& exposures = survey.exposures.exposures;
   summary.exposures = static_cast<int>(exposures.size());

@@ -408,6 +408,7 @@ RoadLineSummary ExtractSurveyLines(
     threads =
         std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   }
+  PrepareImageCodecs();  // before the worker threads read images
   ParallelFor(total, threads, [&](int e) {
     const Exposure& exposure = exposures[e];
     results[e].resize(extractors.size());

@@ -26,6 +26,7 @@
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
 #include "survey/exposures.h"
+#include "survey/image_io.h"
 #include "survey/math_util.h"
 #include "survey/rig.h"
 #include "survey/roadmarks.h"
@@ -366,6 +367,7 @@ void RenderImages(const SimulationOptions& options,
       failed = true;
     }
   };
+  PrepareImageCodecs();
   std::vector<std::thread> threads;
   for (int w = 0; w < workers; ++w) threads.emplace_back(work);
   for (std::thread& t : threads) t.join();

@@ -206,4 +206,9 @@ cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
   return gray;
 }
 
+void PrepareImageCodecs() {
+  // Any lookup builds the whole registry (decoders and encoders alike).
+  static_cast<void>(cv::haveImageWriter(".png"));
+}
+
 }  // namespace zebrageo

@@ -41,6 +41,14 @@ ImageHeader ReadImageHeader(const std::string& path,
 cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
                       int expected_width = 0, int expected_height = 0);
 
+// Builds OpenCV's image codec registry now. Call it on the thread that is
+// about to start threads which decode or encode images: OpenCV builds the
+// registry on first use behind a function-local static, and the guard's
+// fast-path check sits in uninstrumented code, so ThreadSanitizer sees the
+// second thread read the codecs' strings the first one wrote with nothing
+// ordering them. Built before the threads start, thread creation orders it.
+void PrepareImageCodecs();
+
 }  // namespace zebrageo
 
 #endif  // ZEBRAGEO_SURVEY_IMAGE_IO_H_
