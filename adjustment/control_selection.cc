@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "adjustment/line_discrepancies.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
@@ -34,20 +35,70 @@ ProcessSamples AxisSamples(const std::vector<CrossingDiscrepancy>& crossings,
   return samples;
 }
 
+bool Measures(const CrossingDiscrepancy& witness, int axis) {
+  return witness.valid && witness.variance_m2[axis] < kUnmeasuredVarianceM2;
+}
+
+// The crossings in `use`, then the witnesses that measure `axis`.
+ProcessSamples AxisSamples(const std::vector<CrossingDiscrepancy>& crossings,
+                           const std::vector<bool>& use,
+                           const std::vector<CrossingDiscrepancy>& witnesses,
+                           int axis) {
+  ProcessSamples samples = AxisSamples(crossings, use, axis);
+  for (const CrossingDiscrepancy& w : witnesses) {
+    if (Measures(w, axis)) {
+      samples.Add(w.time_s, w.value_m[axis], w.variance_m2[axis]);
+    }
+  }
+  return samples;
+}
+
+std::vector<GaussMarkovFit> FitAxesWith(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<bool>& use,
+    const std::vector<CrossingDiscrepancy>& witnesses,
+    const GaussMarkovFitOptions& fit_options) {
+  std::vector<GaussMarkovFit> fits;
+  for (int axis = 0; axis < 3; ++axis) {
+    fits.push_back(FitGaussMarkov(AxisSamples(crossings, use, witnesses, axis),
+                                  fit_options));
+  }
+  return fits;
+}
+
+// Whether the crossings in `others` and the witnesses measure `axis` both
+// before and after `time_s`: then a change of the error on the way to it
+// would show between them.
+bool Bracketed(const std::vector<CrossingDiscrepancy>& crossings,
+               const std::vector<bool>& others,
+               const std::vector<CrossingDiscrepancy>& witnesses, int axis,
+               double time_s) {
+  const ProcessSamples samples =
+      AxisSamples(crossings, others, witnesses, axis);
+  bool before = false;
+  bool after = false;
+  for (double t : samples.time_s) {
+    before = before || t < time_s;
+    after = after || t > time_s;
+  }
+  return before && after;
+}
+
 // Chi-square (3 axes) of crossing `c`'s value, moved by `shift`, against
-// what the other crossings in `use` predict with `fits`.
+// what the other crossings in `use` and the witnesses predict with `fits`.
 double LeaveOneOutChiSquare(const std::vector<CrossingDiscrepancy>& crossings,
-                            const std::vector<bool>& use, int c,
-                            const std::vector<GaussMarkovFit>& fits,
+                            const std::vector<bool>& use,
+                            const std::vector<CrossingDiscrepancy>& witnesses,
+                            int c, const std::vector<GaussMarkovFit>& fits,
                             const Eigen::Vector3d& shift) {
   std::vector<bool> with = use;
   with[c] = true;
-  // Position of c among the samples of `with`.
+  // Position of c among the samples of `with` (the witnesses come after).
   int position = 0;
   for (int k = 0; k < c; ++k) position += with[k] ? 1 : 0;
   double chi_square = 0.0;
   for (int axis = 0; axis < 3; ++axis) {
-    ProcessSamples samples = AxisSamples(crossings, with, axis);
+    ProcessSamples samples = AxisSamples(crossings, with, witnesses, axis);
     samples.value[position] += shift[axis];
     const ProcessPrediction p =
         PredictLeaveOneOut(samples, position, fits[axis]);
@@ -130,19 +181,15 @@ std::vector<CrossingDiscrepancy> CrossingDiscrepancies(
 std::vector<GaussMarkovFit> FitAxes(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<bool>& use, const GaussMarkovFitOptions& fit_options) {
-  std::vector<GaussMarkovFit> fits;
-  for (int axis = 0; axis < 3; ++axis) {
-    fits.push_back(
-        FitGaussMarkov(AxisSamples(crossings, use, axis), fit_options));
-  }
-  return fits;
+  return FitAxesWith(crossings, use, {}, fit_options);
 }
 
 std::vector<CrossingVerdict> SelectConsistentCrossings(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<std::string>& names,
     const GaussMarkovFitOptions& fit_options, double chi_square_threshold,
-    double two_crossings_sigma_m) {
+    double two_crossings_sigma_m,
+    const std::vector<CrossingDiscrepancy>& witnesses) {
   const int n = static_cast<int>(crossings.size());
   std::vector<CrossingVerdict> verdicts(n);
   std::vector<bool> active(n);
@@ -151,7 +198,7 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
     const int count =
         static_cast<int>(std::count(active.begin(), active.end(), true));
     const std::vector<GaussMarkovFit> all =
-        FitAxes(crossings, active, fit_options);
+        FitAxesWith(crossings, active, witnesses, fit_options);
     int worst = -1;
     double worst_chi = 0.0;
     std::vector<GaussMarkovFit> worst_fits;
@@ -163,17 +210,23 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
       others[c] = false;
       std::vector<GaussMarkovFit> fits =
           count <= kMaxCrossingsForRefit
-              ? FitAxes(crossings, others, fit_options)
+              ? FitAxesWith(crossings, others, witnesses, fit_options)
               : all;
       if (count == 2) {
-        // Fitted on the other crossing alone: its sigma is that crossing's
-        // offset, nothing of how the error changes.
+        // Fitted on the other crossing alone, its sigma is that crossing's
+        // offset, nothing of how the error changes; unless witnesses (whole
+        // dashes) measure the axis on both sides of the crossing tested, so
+        // that a change on the way to it would show between them.
         for (int axis : {0, 1}) {
+          if (Bracketed(crossings, others, witnesses, axis,
+                        crossings[c].time_s)) {
+            continue;
+          }
           fits[axis].sigma = std::max(fits[axis].sigma, two_crossings_sigma_m);
         }
       }
-      const double chi = LeaveOneOutChiSquare(crossings, others, c, fits,
-                                              Eigen::Vector3d::Zero());
+      const double chi = LeaveOneOutChiSquare(crossings, others, witnesses, c,
+                                              fits, Eigen::Vector3d::Zero());
       VLOG(1) << "crossing " << names[c] << ": leave-one-out chi-square " << chi
               << " (" << crossings[c].value_m.transpose() << " m)";
       if (chi > worst_chi) {
@@ -191,8 +244,8 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
     const Eigen::Vector3d& period = crossings[worst].period_m;
     if (period.norm() > 0.0) {
       for (double sign : {-1.0, 1.0}) {
-        const double shifted = LeaveOneOutChiSquare(crossings, others, worst,
-                                                    worst_fits, sign * period);
+        const double shifted = LeaveOneOutChiSquare(
+            crossings, others, witnesses, worst, worst_fits, sign * period);
         if (shifted <= chi_square_threshold) verdict.one_period_off = true;
       }
     }
@@ -201,8 +254,11 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
         "crossing " + names[worst] +
         " implies a trajectory correction (along-track " + Fixed(d.x(), 2) +
         " m, cross-track " + Fixed(d.y(), 2) + " m, up " + Fixed(d.z(), 2) +
-        " m) that the other crossings and the GNSS/INS error "
-        "model do not explain (chi-square " +
+        " m) that the other crossings" +
+        (witnesses.empty()
+             ? std::string()
+             : ", the lane-line dashes matched along the track,") +
+        " and the GNSS/INS error model do not explain (chi-square " +
         Fixed(worst_chi, 1) + " > " + Fixed(chi_square_threshold, 1) + ")";
     if (verdict.one_period_off) {
       verdict.reason += "; shifted by one band period (" +
@@ -233,7 +289,8 @@ void RejectInconsistentCrossings(const Context& context,
       adjustment_internal::SelectConsistentCrossings(
           d, crossings.names, PositionFitOptions(context.options),
           context.options.crossing_consistency_chi_square,
-          context.options.two_crossings_position_sigma_m);
+          context.options.two_crossings_position_sigma_m,
+          DashDiscrepancies(*state));
   for (size_t c = 0; c < verdicts.size(); ++c) {
     if (verdicts[c].consistent) continue;
     context.Warn(verdicts[c].reason + ": not used as control");

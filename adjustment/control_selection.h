@@ -54,12 +54,17 @@ struct CrossingVerdict {
 // The verdict per crossing. Crossings without a valid discrepancy are left
 // consistent (untested). `names` label the reasons. With two crossings
 // left, each is tested with a horizontal sigma of at least
-// two_crossings_sigma_m (AdjustmentOptions::two_crossings_position_sigma_m).
+// two_crossings_sigma_m (AdjustmentOptions::two_crossings_position_sigma_m)
+// on each axis the witnesses do not measure on both sides of it.
+// `witnesses`: discrepancies of other control (whole dashes,
+// DashDiscrepancies) that vote in every test, on the axes they measure
+// (variance below kUnmeasuredVarianceM2), and are never rejected here.
 std::vector<CrossingVerdict> SelectConsistentCrossings(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<std::string>& names,
     const GaussMarkovFitOptions& fit_options, double chi_square_threshold,
-    double two_crossings_sigma_m = 0.0);
+    double two_crossings_sigma_m = 0.0,
+    const std::vector<CrossingDiscrepancy>& witnesses = {});
 
 // The Gauss-Markov fit of each axis (along, cross, up) of the crossings
 // flagged in `use`.

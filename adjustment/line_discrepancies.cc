@@ -132,5 +132,58 @@ std::vector<CrossingDiscrepancy> LineDiscrepancies(const State& state,
   return out;
 }
 
+std::vector<CrossingDiscrepancy> DashDiscrepancies(const State& state) {
+  // A dash measures the error along itself: the along-track error times
+  // cos(angle to the track) plus the cross-track error times its sine.
+  // The cross-track error is not known here (a metre in a city is
+  // possible): counted as this much unknown error, and dashes more than
+  // 10 degrees off the track left out.
+  constexpr double kMinAlongTrackCosine = 0.985;
+  constexpr double kUnknownCrossTrackErrorM = 1.0;
+  std::vector<CrossingDiscrepancy> out;
+  const double start = state.correction.KnotTime(0);
+  for (const State::Line& line : state.lines) {
+    const LineControlPoint& p = line.point;
+    if (!p.along_track) continue;
+    // across_enu holds the dash's direction, row 0 of the whitening its sd.
+    const double information = p.sqrt_information(0, 0);
+    if (!(information > 0.0)) continue;
+    const Eigen::Matrix3d R_track_enu =
+        state.correction.Frame(line.ins_pose).transpose();
+    const Eigen::Vector3d direction_track = R_track_enu * p.across_enu;
+    const double cosine = direction_track.x();
+    if (std::abs(cosine) < kMinAlongTrackCosine) continue;
+    const double sine = direction_track.y();
+    const Eigen::Vector3d X =
+        line.ins_pose.p_enu + line.ins_pose.q_enu_body * p.p_body;
+    const double along_dash = p.across_enu.dot(p.db_point_enu - X);
+    CrossingDiscrepancy d;
+    d.valid = true;
+    d.vertices = 1;
+    d.time_s = p.time;
+    d.variance_m2 = Eigen::Vector3d::Constant(kUnmeasuredVarianceM2);
+    d.value_m.x() = along_dash / cosine;
+    const double cross_track = sine * kUnknownCrossTrackErrorM;
+    d.variance_m2.x() =
+        (1.0 / (information * information) + cross_track * cross_track) /
+        (cosine * cosine);
+    if (!state.knot_prior.empty()) {
+      const double dt = state.correction.knot_spacing();
+      const int k =
+          std::clamp(static_cast<int>(std::lround((d.time_s - start) / dt)), 0,
+                     static_cast<int>(state.knot_prior.size()) - 1);
+      d.value_m.x() -= state.knot_prior[k].tail<3>().x();
+    }
+    VLOG(2) << "dash discrepancy at " << d.time_s << " s: " << d.value_m.x()
+            << " m along the track, sd " << std::sqrt(d.variance_m2.x());
+    out.push_back(d);
+  }
+  std::sort(out.begin(), out.end(),
+            [](const CrossingDiscrepancy& a, const CrossingDiscrepancy& b) {
+              return a.time_s < b.time_s;
+            });
+  return out;
+}
+
 }  // namespace adjustment_internal
 }  // namespace zebrageo

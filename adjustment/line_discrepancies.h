@@ -34,6 +34,14 @@ std::vector<CrossingDiscrepancy> LineDiscrepancies(const State& state,
                                                    double bin_s,
                                                    int min_points);
 
+// One along-track discrepancy per whole dash matched to a database dash
+// (LineControlPoint::along_track: database centre minus the reconstructed
+// centre placed with the INS trajectory, along the dash, in the track
+// frame), in time order; the other axes unmeasured. Dashes that run more
+// than 25 degrees off the track are left out (they measure the along-track
+// error only in part). The jumps of knot_prior are taken out.
+std::vector<CrossingDiscrepancy> DashDiscrepancies(const State& state);
+
 }  // namespace adjustment_internal
 }  // namespace zebrageo
 
