@@ -95,7 +95,10 @@ void ScoreMatches(const sim::SimulatedSurvey& simulated,
     if (!crossing.in_street || !crossing.in_db) continue;
     ++result->crossings_matchable;
     if (!crossing.repainted) ++result->consistent_crossings;
-    if (matched.count(crossing.id)) ++result->crossings_matched;
+    if (matched.count(crossing.id) == 0) continue;
+    ++result->crossings_matched;
+    ++(crossing.repainted ? result->repainted_matched
+                          : result->consistent_matched);
   }
 }
 
@@ -506,6 +509,9 @@ GeometrySweepSummary Summarise(const std::vector<GeometryRunResult>& results) {
     s.right_matches += r.right;
     s.crossings_matchable += r.crossings_matchable;
     s.crossings_matched += r.crossings_matched;
+    s.consistent_crossings += r.consistent_crossings;
+    s.consistent_matched += r.consistent_matched;
+    s.repainted_matched += r.repainted_matched;
     s.worse_position += r.worse_position ? 1 : 0;
     s.worse_attitude += r.worse_attitude ? 1 : 0;
     s.unusable += r.usable ? 0 : 1;
@@ -562,9 +568,9 @@ std::vector<std::string> GeometrySweepSummary::Failures() const {
   }
   if (MatchedShare() < 0.9) {
     failures.push_back("crossings matched " + Fixed(100.0 * MatchedShare(), 1) +
-                       " % (" + std::to_string(crossings_matched) + "/" +
-                       std::to_string(crossings_matchable) +
-                       ") of the matchable (must be >= 90 %)");
+                       " % (" + std::to_string(consistent_matched) + "/" +
+                       std::to_string(consistent_crossings) +
+                       ") of the matchable not repainted (must be >= 90 %)");
   }
   return failures;
 }
@@ -577,7 +583,12 @@ std::string GeometrySweepSummary::Report() const {
       << surveys_with_wrong_matches << " surveys; " << wrong_on_cut_bands
       << " on bands cut short), right " << right_matches << "\n"
       << "  crossings matched " << Fixed(100.0 * MatchedShare(), 1) << " % ("
-      << crossings_matched << "/" << crossings_matchable << ")\n"
+      << consistent_matched << "/" << consistent_crossings
+      << ") of the matchable not repainted; of all matchable "
+      << Fixed(100.0 * AllMatchedShare(), 1) << " % (" << crossings_matched
+      << "/" << crossings_matchable << "); repainted ones kept as control "
+      << repainted_matched << " of "
+      << crossings_matchable - consistent_crossings << "\n"
       << "  worse than the input: position " << worse_position << ", attitude "
       << worse_attitude << "\n"
       << "  unusable adjustments (exit 3) " << unusable << ", of which "
