@@ -90,5 +90,21 @@ TEST(GeometryRegressions, Seed435NoSearchPastTheLastCrossTrackControl) {
   EXPECT_FALSE(r.worse_position) << r.Line();
 }
 
+// Two crossings, the second repainted 0.64 m along the track and matched
+// by the second pass; two crossings alone cannot tell which is wrong, and
+// the trajectory followed the repainted one (H 8.9 -> 22.9 cm). Whole
+// dashes before the first and 3 s past the second agree with the first:
+// the repainted one is rejected, the right one kept.
+TEST(GeometryRegressions, Seed572DashesFindTheRepaintedOfTwoCrossings) {
+  const GeometryRunResult r = RunSeed(572);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_EQ(r.repainted_matched, 0) << r.Line();
+  EXPECT_EQ(r.consistent_matched, 1) << r.Line();
+  EXPECT_FALSE(r.worse_position) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.08) << r.Line();
+}
+
 }  // namespace
 }  // namespace zebrageo::support
