@@ -37,9 +37,11 @@ std::vector<CrossingDiscrepancy> LineDiscrepancies(const State& state,
 // One along-track discrepancy per whole dash matched to a database dash
 // (LineControlPoint::along_track: database centre minus the reconstructed
 // centre placed with the INS trajectory, along the dash, in the track
-// frame), in time order; the other axes unmeasured. Dashes that run more
-// than 25 degrees off the track are left out (they measure the along-track
-// error only in part). The jumps of knot_prior are taken out.
+// frame), in time order; the other axes unmeasured. A dash also measures
+// the cross-track error times the sine of its angle to the track: that
+// part is in the variance (a metre unknown), and dashes more than 10
+// degrees off the track are left out. The jumps of knot_prior are taken
+// out.
 std::vector<CrossingDiscrepancy> DashDiscrepancies(const State& state);
 
 }  // namespace adjustment_internal
