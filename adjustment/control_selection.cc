@@ -212,18 +212,18 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
           count <= kMaxCrossingsForRefit
               ? FitAxesWith(crossings, others, witnesses, fit_options)
               : all;
-      if (count == 2) {
-        // Fitted on the other crossing alone, its sigma is that crossing's
-        // offset, nothing of how the error changes; unless witnesses (whole
-        // dashes) measure the axis on both sides of the crossing tested, so
-        // that a change on the way to it would show between them.
-        for (int axis : {0, 1}) {
-          if (Bracketed(crossings, others, witnesses, axis,
-                        crossings[c].time_s)) {
-            continue;
-          }
-          fits[axis].sigma = std::max(fits[axis].sigma, two_crossings_sigma_m);
+      // Fitted on crossings all on one side of the one tested (the other
+      // of two, or a cluster at the far end of the survey), the sigma says
+      // nothing of how the error changes on the way to it: at least
+      // two_crossings_sigma_m on a horizontal axis, unless other crossings
+      // or witnesses (whole dashes) measure it on both sides, so that a
+      // change on the way would show between them.
+      for (int axis : {0, 1}) {
+        if (Bracketed(crossings, others, witnesses, axis,
+                      crossings[c].time_s)) {
+          continue;
         }
+        fits[axis].sigma = std::max(fits[axis].sigma, two_crossings_sigma_m);
       }
       const double chi = LeaveOneOutChiSquare(crossings, others, witnesses, c,
                                               fits, Eigen::Vector3d::Zero());

@@ -52,10 +52,11 @@ struct CrossingVerdict {
 };
 
 // The verdict per crossing. Crossings without a valid discrepancy are left
-// consistent (untested). `names` label the reasons. With two crossings
-// left, each is tested with a horizontal sigma of at least
+// consistent (untested). `names` label the reasons. A crossing that no
+// other crossing or witness brackets on an axis (the other of two, or one
+// beyond all the others) is tested with a horizontal sigma of at least
 // two_crossings_sigma_m (AdjustmentOptions::two_crossings_position_sigma_m)
-// on each axis the witnesses do not measure on both sides of it.
+// on that axis.
 // `witnesses`: discrepancies of other control (whole dashes,
 // DashDiscrepancies) that vote in every test, on the axes they measure
 // (variance below kUnmeasuredVarianceM2), and are never rejected here.

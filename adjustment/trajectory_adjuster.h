@@ -168,13 +168,15 @@ struct AdjustmentOptions {
   // chi-square (3 degrees of freedom) above this rejects it, worst first,
   // until the rest agree (16.27: p = 0.001).
   double crossing_consistency_chi_square = 16.27;
-  // Two crossings alone test each other through an error model fitted on
-  // one of them, which says nothing of how the error changes: one near the
-  // INS trajectory would make a metre-size drift over tens of metres
-  // (multipath, issue 17) look like a blunder, and which of the two is
-  // dropped is a toss. The horizontal sigma of that test is at least this
-  // (a GNSS/INS error in a city: decimetres to metres); only a jump it
-  // cannot explain rejects one.
+  // A crossing tested against others all on one side of it (the other of
+  // two, or a cluster 150 m away: seed 428) meets an error model fitted
+  // there, which says nothing of how the error changes on the way: one
+  // near the INS trajectory would make a metre-size drift over tens of
+  // metres (multipath, issue 17) look like a blunder, and with two which
+  // is dropped is a toss. The horizontal sigma of that test is at least
+  // this (a GNSS/INS error in a city: decimetres to metres) on each axis
+  // that no other crossing or whole dash measures on both sides of it;
+  // only a jump it cannot explain rejects one.
   double two_crossings_position_sigma_m = 1.0;
 
   // ---------------------------------------------------- blunders

@@ -175,8 +175,16 @@ void KeepMeasuredAcross(const std::vector<double>& times, double gap_m,
   observations->erase(
       std::remove_if(observations->begin(), observations->end(),
                      [&](const CrossingObservation& o) {
-                       return !NearAny(times, o.time_s, trajectory, gap_m) &&
-                              !BoundedByLines(record, times, o.time_s, rematch);
+                       const bool unmeasured =
+                           !NearAny(times, o.time_s, trajectory, gap_m) &&
+                           !BoundedByLines(record, times, o.time_s, rematch);
+                       VLOG_IF(1, unmeasured)
+                           << "second pass: exposure " << o.exposure_id
+                           << " group " << o.group_id
+                           << " not searched: nothing measured the "
+                              "cross-track position within "
+                           << gap_m << " m or on both sides";
+                       return unmeasured;
                      }),
       observations->end());
 }

@@ -106,5 +106,20 @@ TEST(GeometryRegressions, Seed572DashesFindTheRepaintedOfTwoCrossings) {
   EXPECT_LT(r.h_after_m, 0.08) << r.Line();
 }
 
+// Three right crossings and a 1.4 m multipath switch: the first lies
+// 0.45 m off the other two, which agree with each other. The error model
+// fitted on those two allowed too little change on the way to it, and it
+// was rejected (11 vertex matches, H 57.2 -> 54.3 cm). Tested beyond the
+// others, it gets the same 1 m floor as one of two, and is kept.
+TEST(GeometryRegressions, Seed518ACrossingBeyondTheOthersIsKept) {
+  const GeometryRunResult r = RunSeed(518);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_EQ(r.rejected_by_adjustment, 0) << r.Line();
+  EXPECT_EQ(r.consistent_matched, 3) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.08) << r.Line();
+}
+
 }  // namespace
 }  // namespace zebrageo::support
