@@ -27,6 +27,15 @@ Eigen::Matrix<double, 6, 1> ErrorModel::Tau() const {
   return tau;
 }
 
+Eigen::Vector3d State::PriorJumpAt(double time) const {
+  if (knot_prior.empty()) return Eigen::Vector3d::Zero();
+  const int k = std::clamp(
+      static_cast<int>(std::lround((time - correction.KnotTime(0)) /
+                                   correction.knot_spacing())),
+      0, static_cast<int>(knot_prior.size()) - 1);
+  return knot_prior[k].tail<3>();
+}
+
 int State::ExposureIndex(double time) const {
   const auto it = std::lower_bound(exposure_times.begin(), exposure_times.end(),
                                    time - 1e-6);

@@ -158,6 +158,9 @@ struct State {
 
   // Index of the exposure at `time` (to a microsecond), or -1.
   int ExposureIndex(double time) const;
+  // The position part of knot_prior at the knot nearest `time` (the jumps
+  // taken out of the trajectory before it; track frame), zero without.
+  Eigen::Vector3d PriorJumpAt(double time) const;
 };
 
 // The camera's mounting after its correction.

@@ -166,14 +166,7 @@ std::vector<CrossingDiscrepancy> CrossingDiscrepancies(
     d.period_m = period;
     // The jumps taken out of the trajectory before this time are part of
     // the correction (adjustment_state.h): the process is the rest.
-    if (!state.knot_prior.empty()) {
-      const double dt = state.correction.knot_spacing();
-      const int k = std::clamp(
-          static_cast<int>(
-              std::lround((d.time_s - state.correction.KnotTime(0)) / dt)),
-          0, static_cast<int>(state.knot_prior.size()) - 1);
-      d.value_m -= state.knot_prior[k].tail<3>();
-    }
+    d.value_m -= state.PriorJumpAt(d.time_s);
   }
   return out;
 }

@@ -115,15 +115,9 @@ std::vector<CrossingDiscrepancy> LineDiscrepancies(const State& state,
     d.value_m[0] = 0.0;
     d.value_m[2] = median_up;
     if (across.empty()) d.value_m[1] = 0.0;
-    if (!state.knot_prior.empty()) {
-      const double dt = state.correction.knot_spacing();
-      const int k =
-          std::clamp(static_cast<int>(std::lround((d.time_s - start) / dt)), 0,
-                     static_cast<int>(state.knot_prior.size()) - 1);
-      const Eigen::Vector3d jump = state.knot_prior[k].tail<3>();
-      d.value_m[1] -= jump[1];
-      d.value_m[2] -= jump[2];
-    }
+    const Eigen::Vector3d jump = state.PriorJumpAt(d.time_s);
+    d.value_m[1] -= jump[1];
+    d.value_m[2] -= jump[2];
     VLOG(2) << "line discrepancy at " << d.time_s << " s (" << lines.size()
             << " points): " << d.value_m.transpose() << " m, sd "
             << d.variance_m2.cwiseSqrt().transpose();
@@ -141,7 +135,6 @@ std::vector<CrossingDiscrepancy> DashDiscrepancies(const State& state) {
   constexpr double kMinAlongTrackCosine = 0.985;
   constexpr double kUnknownCrossTrackErrorM = 1.0;
   std::vector<CrossingDiscrepancy> out;
-  const double start = state.correction.KnotTime(0);
   for (const State::Line& line : state.lines) {
     const LineControlPoint& p = line.point;
     if (!p.along_track) continue;
@@ -167,13 +160,7 @@ std::vector<CrossingDiscrepancy> DashDiscrepancies(const State& state) {
     d.variance_m2.x() =
         (1.0 / (information * information) + cross_track * cross_track) /
         (cosine * cosine);
-    if (!state.knot_prior.empty()) {
-      const double dt = state.correction.knot_spacing();
-      const int k =
-          std::clamp(static_cast<int>(std::lround((d.time_s - start) / dt)), 0,
-                     static_cast<int>(state.knot_prior.size()) - 1);
-      d.value_m.x() -= state.knot_prior[k].tail<3>().x();
-    }
+    d.value_m.x() -= state.PriorJumpAt(d.time_s).x();
     VLOG(2) << "dash discrepancy at " << d.time_s << " s: " << d.value_m.x()
             << " m along the track, sd " << std::sqrt(d.variance_m2.x());
     out.push_back(d);
