@@ -32,8 +32,15 @@ std::vector<VertexMatch> RefinedMatches(const MatchState& state, int o,
   const Obs& obs = state.obs[o];
   const Hypothesis& h = state.hypotheses[o][state.chosen[o]];
   // Refine on this observation's own bands, then keep the bands whose every
-  // corner fits.
-  const PoseCorrection c = Refine(state, obs, h.eval, h.correction);
+  // corner fits. One band alone (a second pass, min_hit_bands = 1) fixes
+  // neither the heading nor its position along itself, where an end may
+  // be cut short: refined on it, the cut is split between its ends and
+  // both pass. It is checked against the trajectory as it stands, which
+  // the second pass searches only where the adjustment holds it to
+  // centimetres.
+  const PoseCorrection c = h.eval.hits.size() == 1
+                               ? PoseCorrection()
+                               : Refine(state, obs, h.eval, h.correction);
   const Eval eval = Evaluate(state, obs, c);
   *correction = c;
   bands->clear();

@@ -28,6 +28,10 @@ std::string RematchOptions::Check() const {
     return "min_control_crossings = " + std::to_string(min_control_crossings) +
            ": must be >= 1";
   }
+  if (min_hit_bands < 1) {
+    return "min_hit_bands = " + std::to_string(min_hit_bands) +
+           ": must be >= 1";
+  }
   if (!(gate_m > 0.0) || !std::isfinite(gate_m)) {
     return "gate_m = " + std::to_string(gate_m) + ": must be finite and > 0";
   }
@@ -265,6 +269,7 @@ MatchResult MatchOnAdjustedTrajectory(
     tight.max_drift_m = rematch.gate_m;
     tight.sd_gate_factor = rematch.sd_gate_factor;
     tight.max_heading_error_rad = rematch.max_heading_error_rad;
+    tight.min_hit_bands = rematch.min_hit_bands;
   }
   for (const CrossingObservation& o : input.observations) {
     for (const ObservedBand& b : o.bands) {

@@ -121,5 +121,33 @@ TEST(GeometryRegressions, Seed518ACrossingBeyondTheOthersIsKept) {
   EXPECT_LT(r.h_after_m, 0.08) << r.Line();
 }
 
+// The fourth crossing is seen as one band per image. The second pass
+// searched it on the adjusted trajectory (centimetres across the track,
+// the neighbouring bands a metre away) yet refused one band
+// (min_hit_bands = 2): H 18.0 cm. One band is matched there now.
+TEST(GeometryRegressions, Seed138OneBandMatchedOnTheAdjustedTrajectory) {
+  const GeometryRunResult r = RunSeed(138);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_EQ(r.crossings_matched, r.crossings_matchable) << r.Line();
+  EXPECT_EQ(r.crossings_matchable, 4) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.15) << r.Line();
+}
+
+// One-band matches of the second pass, one of them a band cut short at
+// one end: refined on itself, the cut was split between its ends, both
+// passed the 15 cm tolerance and the cut end's vertex was matched 0.2 m
+// off (1 wrong vertex match). Checked against the adjusted trajectory
+// unrefined, the cut end is left out.
+TEST(GeometryRegressions, Seed780OneBandCutShortIsNotRefinedOnItself) {
+  const GeometryRunResult r = RunSeed(780);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_GE(r.right, 200) << r.Line();  // 186 without one-band matches
+  EXPECT_LT(r.h_after_m, 0.05) << r.Line();
+}
+
 }  // namespace
 }  // namespace zebrageo::support
