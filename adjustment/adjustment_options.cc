@@ -72,6 +72,7 @@ std::string AdjustmentOptions::Check() const {
       {"vehicle_motion_correlation_s", vehicle_motion_correlation_s},
       {"vehicle_motion_half_chord_s", vehicle_motion_half_chord_s},
       {"vehicle_misalignment_sigma_rad", vehicle_misalignment_sigma_rad},
+      {"lines_only_misalignment_sigma_rad", lines_only_misalignment_sigma_rad},
       {"axle_offset_sigma_m", axle_offset_sigma_m},
       {"vehicle_motion_loss_scale", vehicle_motion_loss_scale},
   };

@@ -4,6 +4,7 @@
 #include <glog/logging.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 
 #include "adjustment/cost_functions.h"
@@ -333,7 +334,15 @@ void AdjustmentProblem::AddVehicleMotion() {
   double* vehicle = state_->vehicle.data();
   problem_->AddParameterBlock(vehicle, kVehicleSize);
   ++num_pose_blocks_;
-  const double misalignment = 1.0 / options_.vehicle_misalignment_sigma_rad;
+  // Road lines alone (the along-track position held): a yaw misalignment
+  // and a cross-track ramp are one and the same beyond the lines' span,
+  // so the misalignment's prior tightens (AdjustmentOptions).
+  const double misalignment_sigma_rad =
+      state_->along_track_held
+          ? std::min(options_.vehicle_misalignment_sigma_rad,
+                     options_.lines_only_misalignment_sigma_rad)
+          : options_.vehicle_misalignment_sigma_rad;
+  const double misalignment = 1.0 / misalignment_sigma_rad;
   const Eigen::Matrix3d S =
       Eigen::Vector3d(misalignment, 1.0 / options_.axle_offset_sigma_m,
                       misalignment)

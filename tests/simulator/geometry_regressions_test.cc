@@ -121,6 +121,20 @@ TEST(GeometryRegressions, Seed518ACrossingBeyondTheOthersIsKept) {
   EXPECT_LT(r.h_after_m, 0.08) << r.Line();
 }
 
+// No crossing matched (ambiguous), road lines only over the first part of
+// the street: their correction was fitted with a yaw misalignment of the
+// INS to the vehicle, and the vehicle-motion constraint carried its ramp
+// beyond them (H 80.8 -> 33.4 cm). With lines alone the INS's heading is
+// trusted to 0.1 degree (AdjustmentOptions::lines_only_misalignment_...).
+TEST(GeometryRegressions, Seed471LinesAloneDoNotFitAMisalignmentRamp) {
+  const GeometryRunResult r = RunSeed(471);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_GT(r.h_before_m, 0.75) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.2) << r.Line();
+}
+
 // The fourth crossing is seen as one band per image. The second pass
 // searched it on the adjusted trajectory (centimetres across the track,
 // the neighbouring bands a metre away) yet refused one band
