@@ -336,7 +336,8 @@ void AdjustmentProblem::AddVehicleMotion() {
   ++num_pose_blocks_;
   // Road lines alone (the along-track position held): a yaw misalignment
   // and a cross-track ramp are one and the same beyond the lines' span,
-  // so the misalignment's prior tightens (AdjustmentOptions).
+  // so the misalignment's prior tightens (AdjustmentOptions); the pitch
+  // misalignment shares the prior, and tightens with it (as measured).
   const double misalignment_sigma_rad =
       state_->along_track_held
           ? std::min(options_.vehicle_misalignment_sigma_rad,
