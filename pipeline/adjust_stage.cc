@@ -46,6 +46,40 @@ std::vector<double> CrossTrackTimes(
   return times;
 }
 
+// The times of the control points of CrossTrackTimes that `result`'s
+// trajectory fits across their line within max_residual_m, sorted. A
+// point it does not fit (a GNSS switch the smooth correction could not
+// follow, a line moved in the database) measured nothing the trajectory
+// holds.
+std::vector<double> FittedCrossTrackTimes(
+    const std::vector<LineControlPoint>& control,
+    const AdjustmentResult& result, double max_residual_m) {
+  const auto& samples = result.corrected_samples;
+  if (samples.size() < 2 || result.corrected_poses.size() != samples.size()) {
+    return {};
+  }
+  std::vector<LineControlPoint> fitted;
+  for (const LineControlPoint& c : control) {
+    if (c.time < samples.front().time || c.time > samples.back().time) {
+      continue;
+    }
+    // Interpolated as Trajectory::InterpolatePose does.
+    const auto it = std::upper_bound(
+        samples.begin(), samples.end(), c.time,
+        [](double t, const TrajectorySample& s) { return t < s.time; });
+    const size_t i = std::min<size_t>(
+        std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
+    const double span = samples[i + 1].time - samples[i].time;
+    const double u = span > 0.0 ? (c.time - samples[i].time) / span : 0.0;
+    const Pose pose = InterpolatePoses(result.corrected_poses[i],
+                                       result.corrected_poses[i + 1], u);
+    const double residual =
+        c.across_enu.dot(pose.T_enu_body() * c.p_body - c.db_point_enu);
+    if (std::abs(residual) <= max_residual_m) fitted.push_back(c);
+  }
+  return CrossTrackTimes(fitted);
+}
+
 }  // namespace
 
 AdjustmentResult AdjustWithRoadLines(
@@ -53,8 +87,10 @@ AdjustmentResult AdjustWithRoadLines(
     const AdjustmentOptions& options,
     const std::vector<ReconstructedLinePoint>* line_points,
     const std::string& results_folder, std::vector<std::string>* warnings,
-    const ProgressListener& progress, std::vector<double>* line_control_times) {
+    const ProgressListener& progress, std::vector<double>* line_control_times,
+    std::vector<double>* fitted_line_times) {
   if (line_control_times != nullptr) line_control_times->clear();
+  if (fitted_line_times != nullptr) fitted_line_times->clear();
   StepProgress step(progress, "adjust");
   AdjustmentResult result = AdjustTrajectory(options, input, step.Callback());
   step.Finish();
@@ -69,6 +105,10 @@ AdjustmentResult AdjustWithRoadLines(
   StepProgress line_step(progress, "adjust with lines");
   result = AdjustTrajectory(options, input, line_step.Callback());
   line_step.Finish();
+  if (fitted_line_times != nullptr && result.summary.IsUsable()) {
+    *fitted_line_times =
+        FittedCrossTrackTimes(control, result, kFittedLineResidualM);
+  }
   return result;
 }
 
@@ -85,11 +125,11 @@ bool SecondPassOnRoadLines(const AdjustmentRecord& record,
   return false;
 }
 
-std::vector<std::string> RunAdjustStage(const Survey& survey,
-                                        StageResults* results,
-                                        const AdjustmentOptions& options,
-                                        bool tie_points, bool lines,
-                                        const ProgressListener& progress) {
+std::vector<std::string> RunAdjustStage(
+    const Survey& survey, StageResults* results,
+    const AdjustmentOptions& options, bool tie_points, bool lines,
+    const ProgressListener& progress, std::vector<double>* line_control_times,
+    std::vector<double>* fitted_line_times) {
   const std::string& results_folder = results->folder();
   // The survey as loaded (not read again), with the stages' outputs.
   AdjustmentData data =
@@ -120,7 +160,8 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
   std::vector<std::string> warnings = data.warnings;
   AdjustmentResult result = AdjustWithRoadLines(
       data, input, options, lines ? results->LinePoints() : nullptr,
-      results_folder, &warnings, progress);
+      results_folder, &warnings, progress, line_control_times,
+      fitted_line_times);
   if (!result.summary.IsUsable()) {
     // A solver's message ("Ceres failed: ...") names no input: the survey's
     // warnings (gaps, rates, with their lines and times) may.

@@ -55,11 +55,14 @@ void ThrowIfTooManyUnreadable(const Survey& survey,
 // trajectory (line_matches.csv, line_control.json).
 // The survey's warnings are part of the returned ones (and of
 // adjustment.json's); exposures the reconstruction skipped get no pose.
-std::vector<std::string> RunAdjustStage(const Survey& survey,
-                                        StageResults* results,
-                                        const AdjustmentOptions& options,
-                                        bool tie_points, bool lines,
-                                        const ProgressListener& progress);
+// *line_control_times and *fitted_line_times (when not null):
+// AdjustWithRoadLines'.
+std::vector<std::string> RunAdjustStage(
+    const Survey& survey, StageResults* results,
+    const AdjustmentOptions& options, bool tie_points, bool lines,
+    const ProgressListener& progress,
+    std::vector<double>* line_control_times = nullptr,
+    std::vector<double>* fitted_line_times = nullptr);
 
 // The adjustment of `input` (zebra control), then, with `line_points`,
 // again with the road lines matched on its trajectory
@@ -68,14 +71,18 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
 // "adjust with lines"; `progress` may be null. *line_control_times (when
 // not null): the times of the line points that held the cross-track
 // position (the second pass searches only near them after road lines
-// alone).
+// alone). *fitted_line_times (when not null): those of them that the
+// returned trajectory fits across their line within kFittedLineResidualM
+// (RematchInput::across_from_fitted_lines).
+inline constexpr double kFittedLineResidualM = 0.1;
 AdjustmentResult AdjustWithRoadLines(
     const AdjustmentData& data, AdjustmentInput input,
     const AdjustmentOptions& options,
     const std::vector<ReconstructedLinePoint>* line_points,
     const std::string& results_folder, std::vector<std::string>* warnings,
     const ProgressListener& progress,
-    std::vector<double>* line_control_times = nullptr);
+    std::vector<double>* line_control_times = nullptr,
+    std::vector<double>* fitted_line_times = nullptr);
 
 // Whether the second registration pass should search on the trajectory the
 // road lines alone correct (AdjustByRoadLinesAlone) rather than on the

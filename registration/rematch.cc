@@ -51,6 +51,10 @@ std::string RematchOptions::Check() const {
            std::to_string(max_cross_track_control_gap_m) +
            ": must be finite and >= 0";
   }
+  if (!(max_sideways_m >= 0.0) || !(max_sideways_m < 0.5)) {
+    return "max_sideways_m = " + std::to_string(max_sideways_m) +
+           ": must be in [0, 0.5)";
+  }
   if (!(max_line_drift_sd_m >= 0.0) || !std::isfinite(max_line_drift_sd_m)) {
     return "max_line_drift_sd_m = " + std::to_string(max_line_drift_sd_m) +
            ": must be finite and >= 0";
@@ -91,6 +95,7 @@ std::vector<double> SortedExposureTimes(
 // "" when the adjustment (its adjustment.json, survey/results_adjustment.h,
 // null when missing) can gate the second pass, else why not.
 std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
+                                      bool across_from_fitted_lines,
                                       int min_control_crossings) {
   if (record == nullptr) {
     return std::string(kAdjustmentJsonFile) + " is missing";
@@ -101,6 +106,8 @@ std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
   // Road lines alone: their error model is fitted on many stretches of
   // line, and the pass is gated across the track only.
   if (record->road_lines_only) return "";
+  // Gated across the track by the lines the adjusted trajectory fits.
+  if (across_from_fitted_lines) return "";
   const int crossings =
       record->counts.control_crossings + record->counts.check_crossings;
   if (crossings < min_control_crossings) {
@@ -165,6 +172,82 @@ bool BoundedByLines(const AdjustmentRecord& record,
   const double gap_s = BracketGap(line_times, t);
   return gap_s <= rematch.max_line_bracket_gap_s &&
          CrossTrackDriftSd(record, gap_s) <= rematch.max_line_drift_sd_m;
+}
+
+// How far the vehicle moved sideways on `trajectory` from time t0 to t1:
+// its horizontal displacement across its own heading, summed over the
+// samples between them (negative to the left).
+double SidewaysMotion(const Trajectory& trajectory, double t0, double t1) {
+  if (t1 < t0) std::swap(t0, t1);
+  std::vector<double> times = {t0};
+  for (const TrajectorySample& s : trajectory.samples()) {
+    if (s.time > t0 && s.time < t1) times.push_back(s.time);
+  }
+  times.push_back(t1);
+  Pose previous;
+  if (!trajectory.InterpolatePose(t0, &previous)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  double sideways = 0.0;
+  for (size_t k = 1; k < times.size(); ++k) {
+    Pose pose;
+    if (!trajectory.InterpolatePose(times[k], &pose)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    // Body FRD: y points right.
+    Eigen::Vector3d right = previous.q_enu_body * Eigen::Vector3d::UnitY();
+    right.z() = 0.0;
+    if (right.norm() > 0.0)
+      sideways += (pose.p_enu - previous.p_enu).dot(right.normalized());
+    previous = pose;
+  }
+  return sideways;
+}
+
+// Whether one of the sorted `times` just before or just after `t` lies at
+// most `gap_m` travelled (horizontally, on `trajectory`) from it with the
+// vehicle moving at most `max_sideways_m` sideways in between.
+bool NearWithoutSidewaysMotion(const std::vector<double>& sorted, double t,
+                               const Trajectory& trajectory, double gap_m,
+                               double max_sideways_m) {
+  Pose at;
+  if (!trajectory.InterpolatePose(t, &at)) return false;
+  const auto after = std::lower_bound(sorted.begin(), sorted.end(), t);
+  for (auto it : {after, after == sorted.begin() ? sorted.end() : after - 1}) {
+    Pose pose;
+    if (it != sorted.end() && trajectory.InterpolatePose(*it, &pose) &&
+        (pose.p_enu - at.p_enu).head<2>().norm() <= gap_m &&
+        std::abs(SidewaysMotion(trajectory, *it, t)) <= max_sideways_m) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// Drops the observations near no line point that the adjusted trajectory
+// fits or farther from it than max_sideways_m sideways
+// (RematchInput::across_from_fitted_lines).
+void KeepNearFittedLines(const std::vector<double>& times,
+                         const Trajectory& trajectory,
+                         const RematchOptions& rematch,
+                         std::vector<CrossingObservation>* observations) {
+  observations->erase(
+      std::remove_if(
+          observations->begin(), observations->end(),
+          [&](const CrossingObservation& o) {
+            const bool unmeasured = !NearWithoutSidewaysMotion(
+                times, o.time_s, trajectory, rematch.max_line_control_gap_m,
+                rematch.max_sideways_m);
+            VLOG_IF(1, unmeasured)
+                << "second pass: exposure " << o.exposure_id << " group "
+                << o.group_id
+                << " not searched: no line point the adjusted trajectory "
+                   "fits within "
+                << rematch.max_line_control_gap_m << " m without moving over "
+                << rematch.max_sideways_m << " m sideways";
+            return unmeasured;
+          }),
+      observations->end());
 }
 
 // Drops the observations where nothing measured the cross-track position:
@@ -240,11 +323,19 @@ MatchResult MatchOnAdjustedTrajectory(
     };
   }
   MatchOptions tight = options;
-  if (first.adjustment->road_lines_only) {
+  const std::vector<double> none;
+  if (first.across_from_fitted_lines) {
+    KeepNearFittedLines(
+        first.line_control_times != nullptr ? *first.line_control_times : none,
+        adjusted.trajectory, rematch, &input.observations);
+    // Along the track and in heading as the first pass (one or two
+    // crossings: no error model to gate it); across it, a band offset lies
+    // far outside.
+    tight.max_cross_track_m = rematch.cross_track_gate_m;
+  } else if (first.adjustment->road_lines_only) {
     // Only where the lines measured the cross-track position: near one of
     // their points, or between two where their own error model says it
     // cannot have moved by a band offset.
-    const std::vector<double> none;
     KeepMeasuredAcross(
         first.line_control_times != nullptr ? *first.line_control_times : none,
         rematch.max_line_control_gap_m, adjusted.trajectory, *first.adjustment,
@@ -340,7 +431,17 @@ std::vector<CrossingDecision> MergeSecondPass(
   const std::set<std::string> none;
   const std::set<std::string>& rejected =
       input.rejected_crossings != nullptr ? *input.rejected_crossings : none;
-  const bool road_lines_only = input.adjustment->road_lines_only;
+  const bool across_by_lines =
+      input.adjustment->road_lines_only || input.across_from_fitted_lines;
+  const std::string gate =
+      across_by_lines
+          ? std::to_string(rematch.cross_track_gate_m).substr(0, 4) +
+                " m across the track, " +
+                (input.across_from_fitted_lines
+                     ? "near road lines the adjusted trajectory fits"
+                     : "after road lines alone")
+          : std::to_string(rematch.gate_m).substr(0, 4) +
+                " m or 5 posterior sd";
   std::vector<CrossingDecision> merged = first;
   for (CrossingDecision& d : merged) {
     if (d.decision == Decision::kMatched) continue;
@@ -375,12 +476,7 @@ std::vector<CrossingDecision> MergeSecondPass(
     d.decision = Decision::kMatched;
     d.crossing_id = it->crossing_id;
     d.reason = "matched with the adjusted trajectory (second pass; gate " +
-               (road_lines_only
-                    ? std::to_string(rematch.cross_track_gate_m).substr(0, 4) +
-                          " m across the track, after road lines alone"
-                    : std::to_string(rematch.gate_m).substr(0, 4) +
-                          " m or 5 posterior sd") +
-               "): " + it->reason + "; first pass: " + d.reason;
+               gate + "): " + it->reason + "; first pass: " + d.reason;
     ++summary->added;
   }
   return merged;
@@ -394,7 +490,8 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
                                              const RematchOptions& rematch) {
   RematchSummary summary;
   const std::string unfit = AdjustmentUnfitForRematch(
-      first.adjustment, rematch.min_control_crossings);
+      first.adjustment, first.across_from_fitted_lines,
+      rematch.min_control_crossings);
   if (!unfit.empty()) {
     summary.message = "second registration pass skipped: " + unfit;
     return summary;
@@ -516,7 +613,7 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
   }
   RematchInput first;
   first.adjustment = record ? &*record : nullptr;
-  if (!AdjustmentUnfitForRematch(first.adjustment,
+  if (!AdjustmentUnfitForRematch(first.adjustment, false,
                                  rematch.min_control_crossings)
            .empty()) {
     return RematchWithAdjustedTrajectory(survey, first, options, rematch);
@@ -543,9 +640,12 @@ RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
   }
   first.adjusted_trajectory = &adjusted;
   first.vertices = &vertices;
-  // After road lines alone, where they held the cross-track position.
+  // Where road lines held the cross-track position: after them alone the
+  // pass searches only there; after crossings and lines, no farther from
+  // them and the crossings than max_cross_track_control_gap_m. A stale
+  // line_matches.csv can only narrow the search.
   std::vector<double> line_times;
-  if (undecided && first.adjustment->road_lines_only) {
+  if (undecided) {
     line_times = LineControlTimesIn(results_folder, survey.exposures);
   }
   first.line_control_times = &line_times;

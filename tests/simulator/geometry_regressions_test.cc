@@ -163,5 +163,30 @@ TEST(GeometryRegressions, Seed780OneBandCutShortIsNotRefinedOnItself) {
   EXPECT_LT(r.h_after_m, 0.05) << r.Line();
 }
 
+// Two crossings under a multipath error, one matched by the first pass and
+// the other refused as ambiguous (margin 1.0): the pass on the trajectory
+// the road lines alone correct matched nothing more (H 127.5 -> 20.3 cm).
+// The adjustment on the one crossing and the lines fits the lines near the
+// other crossing, and the pass near those line points matches it.
+TEST(GeometryRegressions, Seed146ASecondCrossingNearLinesTheAdjustmentFits) {
+  const GeometryRunResult r = RunSeed(146);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_EQ(r.crossings_matched, 2) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.06) << r.Line();
+}
+
+// The same with a 1.8 m error before correction (H 176.1 -> 18.1 cm with
+// one crossing, 2.3 with both).
+TEST(GeometryRegressions, Seed19ASecondCrossingAfterAMetreOfMultipath) {
+  const GeometryRunResult r = RunSeed(19);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_EQ(r.wrong, 0) << r.Line();
+  EXPECT_EQ(r.crossings_matched, 2) << r.Line();
+  EXPECT_LT(r.h_after_m, 0.05) << r.Line();
+}
+
 }  // namespace
 }  // namespace zebrageo::support

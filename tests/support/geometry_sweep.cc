@@ -274,12 +274,14 @@ std::string GeometryRunResult::Line() const {
 // One second registration pass as `zebrageo run` does it (pipeline.cc):
 // the matches the adjustment rejected removed, then the pass on the
 // adjusted trajectory (on the road lines' alone when the adjustment had
-// too few crossings). Adds the vertex matches the adjustment rejected to
-// *rejected.
+// too few crossings, and when that adds nothing on the adjusted one near
+// the `fitted_line_times`). Adds the vertex matches the adjustment
+// rejected to *rejected.
 RematchSummary SecondPass(
     const Survey& survey, const SyntheticReconstruction& reconstruction,
     const std::vector<ReconstructedLinePoint>* lines,
-    const std::vector<double>* line_control_times, const TruthPaintProbe& probe,
+    const std::vector<double>* line_control_times,
+    const std::vector<double>& fitted_line_times, const TruthPaintProbe& probe,
     const AdjustmentOptions& adjustment, const AdjustmentResult& adjusted,
     AdjustmentData* data, std::vector<CrossingDecision>* decisions,
     int* rejected) {
@@ -313,8 +315,18 @@ RematchSummary SecondPass(
                                const std::vector<BandCornersEnu>& seen) {
     return probe.Classify(exposure_id, pose, band, seen);
   };
-  return RematchWithAdjustedTrajectory(survey, first, MatchOptions(),
-                                       RematchOptions());
+  RematchSummary summary = RematchWithAdjustedTrajectory(
+      survey, first, MatchOptions(), RematchOptions());
+  if (on_lines && summary.added == 0 && summary.dropped == 0 &&
+      record.counts.control_crossings > 0 && !fitted_line_times.empty()) {
+    first.adjustment = &record;
+    first.adjusted_trajectory = &adjusted.corrected_samples;
+    first.line_control_times = &fitted_line_times;
+    first.across_from_fitted_lines = true;
+    summary = RematchWithAdjustedTrajectory(survey, first, MatchOptions(),
+                                            RematchOptions());
+  }
+  return summary;
 }
 
 // What `zebrageo run` does after its first adjustment (pipeline.cc): the
@@ -326,6 +338,7 @@ int RematchAndAdjust(const Survey& survey,
                      const SyntheticReconstruction& reconstruction,
                      const std::vector<ReconstructedLinePoint>* lines,
                      const std::vector<double>* line_control_times,
+                     std::vector<double> fitted_line_times,
                      const TruthPaintProbe& probe,
                      const AdjustmentOptions& adjustment, AdjustmentData* data,
                      std::vector<CrossingDecision> decisions,
@@ -335,17 +348,18 @@ int RematchAndAdjust(const Survey& survey,
   *rejected = 0;
   std::vector<double> times_after;  // line control of a later adjustment
   for (int pass = 0; pass < kMaxPasses; ++pass) {
-    RematchSummary rematch =
-        SecondPass(survey, reconstruction, lines,
-                   pass == 0 ? line_control_times : &times_after, probe,
-                   adjustment, *adjusted, data, &decisions, rejected);
+    RematchSummary rematch = SecondPass(
+        survey, reconstruction, lines,
+        pass == 0 ? line_control_times : &times_after, fitted_line_times, probe,
+        adjustment, *adjusted, data, &decisions, rejected);
     if (rematch.added == 0 && rematch.dropped == 0) break;
     added += rematch.added;
     data->matches = std::move(rematch.matches);
     decisions = std::move(rematch.decisions);
     std::vector<std::string> warnings;
     *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
-                                    &warnings, nullptr, &times_after);
+                                    &warnings, nullptr, &times_after,
+                                    &fitted_line_times);
   }
   return added;
 }
@@ -426,14 +440,16 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
         AdjustmentDataOf(survey, reconstruction.vertices, match.matches);
     std::vector<std::string> warnings;
     std::vector<double> line_control_times;
-    AdjustmentResult adjusted =
-        AdjustWithRoadLines(data, data.Input(), adjustment, lines, "",
-                            &warnings, nullptr, &line_control_times);
+    std::vector<double> fitted_line_times;
+    AdjustmentResult adjusted = AdjustWithRoadLines(
+        data, data.Input(), adjustment, lines, "", &warnings, nullptr,
+        &line_control_times, &fitted_line_times);
     int rejected_first = 0;
     if (options.rematch && adjusted.summary.IsUsable()) {
-      result.rematched = RematchAndAdjust(
-          survey, reconstruction, lines, &line_control_times, probe, adjustment,
-          &data, match.decisions, &adjusted, &rejected_first);
+      result.rematched =
+          RematchAndAdjust(survey, reconstruction, lines, &line_control_times,
+                           fitted_line_times, probe, adjustment, &data,
+                           match.decisions, &adjusted, &rejected_first);
     }
     const std::vector<VertexMatch>& matches = data.matches;
     // Scored as the user gets them: matches.csv keeps only the vertices
