@@ -81,6 +81,9 @@ std::string AdjustmentOptions::Check() const {
       return Violation(p.name, p.value, "must be finite and > 0");
     }
   }
+  if (const std::string why = sideways_switches.Check(); !why.empty()) {
+    return "sideways_switches." + why;
+  }
   if (!(sideslip_sigma_rad >= 0.0) || !std::isfinite(sideslip_sigma_rad)) {
     return Violation("sideslip_sigma_rad", sideslip_sigma_rad,
                      "must be finite and >= 0 (0 disables)");

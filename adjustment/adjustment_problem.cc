@@ -191,7 +191,7 @@ void AdjustmentProblem::AddKnotPriors() {
         // variance grows by what the error gains over this step.
         for (int i = 0; i < 3; ++i) {
           s[i] = std::sqrt(s[i] * s[i] +
-                           state_->knot_extra_variance_m2[k] /
+                           state_->knot_extra_variance_m2[k][i] /
                                std::max(1e-12, 1.0 - phi[3 + i] * phi[3 + i]));
         }
       }

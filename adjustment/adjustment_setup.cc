@@ -180,7 +180,7 @@ void InitialiseCorrection(const Context& context, State* state) {
   state->rig_corrections.assign(context.input.rig->cameras.size(),
                                 std::array<double, kRigCorrectionSize>{});
   context.summary->num_knots = state->correction.num_knots();
-  if (context.dejumped.num_jumps > 0) {
+  if (context.dejumped.num_jumps > 0 || !context.dejumped.switches.empty()) {
     int previous_sample = 0;
     for (int k = 0; k < state->correction.num_knots(); ++k) {
       const double t =
@@ -198,10 +198,20 @@ void InitialiseCorrection(const Context& context, State* state) {
       b.tail<3>() = R_track_enu * context.dejumped.prior_position_offset[i];
       state->knot_prior.push_back(b);
       // What the error gains beyond its process between the two knots'
-      // samples (a jump that stays a step, an outage's closure).
-      double extra = 0.0;
+      // samples (a jump that stays a step, an outage's closure; a sideways
+      // switch's across the track only).
+      Eigen::Vector3d extra = Eigen::Vector3d::Zero();
       for (int j = previous_sample + 1; k > 0 && j <= i; ++j) {
-        extra += context.dejumped.innovation_variance_m2[j];
+        extra += Eigen::Vector3d::Constant(
+            context.dejumped.innovation_variance_m2[j]);
+        // In ENU (track_frame false) the cross-track axis is no axis.
+        const double across =
+            context.dejumped.cross_track_innovation_variance_m2[j];
+        if (options.track_frame) {
+          extra.y() += across;
+        } else {
+          extra += Eigen::Vector3d::Constant(across);
+        }
       }
       state->knot_extra_variance_m2.push_back(extra);
       previous_sample = i;

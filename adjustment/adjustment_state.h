@@ -145,8 +145,9 @@ struct State {
   // Variance added to the position innovation into each knot (m^2, per
   // axis): what the error gains there beyond its process, a jump that
   // stays a step or an outage's closure
-  // (DejumpedTrajectory::innovation_variance_m2); empty: none.
-  std::vector<double> knot_extra_variance_m2;
+  // (DejumpedTrajectory::innovation_variance_m2), per axis of the track
+  // frame (a sideways switch's on the cross-track axis alone); empty: none.
+  std::vector<Eigen::Vector3d> knot_extra_variance_m2;
   ErrorModel model;
   // Attitude components of the correction (0..2 of a knot) held at their
   // prior centre, the input's attitude (attitude_significance.h).

@@ -16,6 +16,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <iomanip>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,12 @@
 
 namespace zebrageo {
 namespace {
+
+std::string FixedText(double value, int decimals) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(decimals) << value;
+  return out.str();
+}
 
 using adjustment_internal::AdjustmentSolver;
 using adjustment_internal::Context;
@@ -116,11 +124,22 @@ AdjustmentResult AdjustTrajectory(
   if (!summary.message.empty()) return result;
   summary.num_exposures = static_cast<int>(input.exposures->exposures.size());
   // The INS trajectory the correction applies to: without its jumps.
-  Context context{options, input,
-                  RemoveJumps(*input.trajectory, options.jump_threshold_m,
-                              options.jump_threshold_rad),
-                  &summary};
+  Context context{
+      options, input,
+      RemoveJumps(*input.trajectory, options.jump_threshold_m,
+                  options.jump_threshold_rad, options.sideways_switches),
+      &summary};
   summary.num_jumps = context.dejumped.num_jumps;
+  for (const SidewaysSwitch& s : context.dejumped.switches) {
+    const std::vector<TrajectorySample>& samples = input.trajectory->samples();
+    context.Warn(
+        "the GNSS/INS positions move " + FixedText(std::abs(s.size_m), 2) +
+        " m " + (s.size_m > 0.0 ? "right" : "left") +
+        " of the heading from time " + FixedText(samples[s.first].time, 2) +
+        " to " + FixedText(samples[s.last].time, 2) +
+        ": a switch of the GNSS error (multipath?), corrected as "
+        "continuous INS motion");
+  }
   if (summary.num_jumps > 0) {
     context.Warn(
         std::to_string(summary.num_jumps) +

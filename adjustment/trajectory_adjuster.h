@@ -49,6 +49,7 @@
 #include "adjustment/line_control.h"
 #include "adjustment/solver_options.h"
 #include "adjustment/trajectory_correction.h"
+#include "adjustment/trajectory_switches.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/math_util.h"
@@ -129,6 +130,11 @@ struct AdjustmentOptions {
   // stays smooth; 0 disables the detection.
   double jump_threshold_m = 0.05;
   double jump_threshold_rad = DegToRad(0.05);
+  // Switches of the GNSS error across the track spread over seconds
+  // (multipath; trajectory_switches.h): taken out as jumps, so that a
+  // correction measured on one side is not carried across with the error
+  // the switch added.
+  SidewaysSwitchOptions sideways_switches;
 
   // ---------------------------------------------------- control points
   // Each control vertex is observed as its exposure's stereo pair

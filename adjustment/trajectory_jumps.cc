@@ -18,11 +18,15 @@ bool OffsetChanges(const DejumpedTrajectory& d, int i) {
          d.rotation_offset[i].angularDistance(d.rotation_offset[i - 1]) > 0.0;
 }
 
+// A sideways switch's steps are not jumps: their variance is the
+// cross-track axis's (MoveSwitchInnovations), and an outage's closure is
+// the jump's alone.
 std::vector<JumpEvent> JumpEvents(const DejumpedTrajectory& d) {
   std::vector<JumpEvent> events;
   const int n = static_cast<int>(d.position_offset.size());
   for (int i = 1; i < n; ++i) {
     if (!OffsetChanges(d, i)) continue;
+    if (!d.switch_step.empty() && d.switch_step[i]) continue;
     if (!events.empty() && events.back().last == i - 1) {
       events.back().last = i;
     } else {
@@ -58,6 +62,29 @@ std::vector<double> ClosureShares(const std::vector<double>& variance,
         std::clamp((variance[i] - variance[k]) / accrued, 0.0, 1.0));
   }
   return share;
+}
+
+// A sideways switch's steps (DejumpedTrajectory::switch_step) free the
+// correction across the track only.
+void MoveSwitchInnovations(const std::vector<Eigen::Vector3d>& sideways,
+                           DejumpedTrajectory* dejumped) {
+  DejumpedTrajectory& d = *dejumped;
+  d.cross_track_innovation_variance_m2.assign(d.innovation_variance_m2.size(),
+                                              0.0);
+  for (const SidewaysSwitch& s : d.switches) {
+    double moved = 0.0;
+    for (int k = s.first + 1; k <= s.last; ++k) {
+      if (d.switch_step[k]) moved += sideways[k].norm();
+    }
+    for (int k = s.first + 1; k <= s.last; ++k) {
+      if (!d.switch_step[k]) continue;
+      // The switch's square spread over its steps as they moved: the
+      // prior's centre moves with it, and the correction may follow
+      // wherever control inside the switch shows it.
+      d.cross_track_innovation_variance_m2[k] =
+          s.size_m * s.size_m * sideways[k].norm() / moved;
+    }
+  }
 }
 
 }  // namespace
@@ -118,15 +145,27 @@ void SpreadOutageClosures(const Trajectory& trajectory,
 }
 
 DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
-                               double threshold_rad) {
+                               double threshold_rad,
+                               const SidewaysSwitchOptions& switches) {
   const std::vector<Pose>& poses = trajectory.poses();
   const int n = static_cast<int>(poses.size());
   DejumpedTrajectory out;
   out.poses = poses;
   out.position_offset.assign(n, Eigen::Vector3d::Zero());
   out.rotation_offset.assign(n, Eigen::Quaterniond::Identity());
+  std::vector<Eigen::Vector3d> sideways;
   if (n < 8 || (threshold_m <= 0.0 && threshold_rad <= 0.0)) {
+    out.switches = FindSidewaysSwitches(trajectory, switches, {}, &sideways);
+    Eigen::Vector3d position_jump = Eigen::Vector3d::Zero();
+    out.switch_step.assign(n, false);
+    for (int i = 1; i < n; ++i) {
+      out.switch_step[i] = !sideways[i].isZero();
+      position_jump += sideways[i];
+      out.position_offset[i] = position_jump;
+      out.poses[i].p_enu = poses[i].p_enu - position_jump;
+    }
     SpreadOutageClosures(trajectory, &out);
+    MoveSwitchInnovations(sideways, &out);
     return out;
   }
   const std::vector<TrajectorySample>& samples = trajectory.samples();
@@ -190,8 +229,16 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
                       ? std::max(threshold_rad,
                                  kJumpNoiseFactor * median_norm(rotation_step))
                       : 0.0;
+  std::vector<bool> position_jumps(n, false);
+  for (int i = 1; i < n; ++i) {
+    position_jumps[i] =
+        threshold_m > 0.0 && position_step[i].norm() > threshold_m;
+  }
+  out.switches =
+      FindSidewaysSwitches(trajectory, switches, position_jumps, &sideways);
   Eigen::Vector3d position_jump = Eigen::Vector3d::Zero();
   Eigen::Quaterniond rotation_jump = Eigen::Quaterniond::Identity();
+  out.switch_step.assign(n, false);
   for (int i = 1; i < n; ++i) {
     bool jumped = false;
     if (threshold_m > 0.0) {
@@ -214,6 +261,11 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
       }
     }
     out.num_jumps += jumped;
+    // A switch's sideways step, unless the step was a jump already.
+    if (!jumped && !sideways[i].isZero()) {
+      out.switch_step[i] = true;
+      position_jump += sideways[i];
+    }
     out.position_offset[i] = position_jump;
     out.rotation_offset[i] = rotation_jump;
     out.poses[i].p_enu = poses[i].p_enu - position_jump;
@@ -221,6 +273,7 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
         (rotation_jump.inverse() * poses[i].q_enu_body).normalized();
   }
   SpreadOutageClosures(trajectory, &out);
+  MoveSwitchInnovations(sideways, &out);
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "adjustment/trajectory_switches.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
@@ -40,16 +41,26 @@ struct DejumpedTrajectory {
   // spread as the closure is, since the stated variance says where the
   // drift accrued but not its exact shape; zero elsewhere.
   std::vector<double> innovation_variance_m2;
+  // The same for the cross-track axis alone (m^2): a sideways switch's
+  // square, at its steps (its error steps across the track only).
+  std::vector<double> cross_track_innovation_variance_m2;
   int num_jumps = 0;
   int num_closed_outages = 0;
+  // Sideways switches taken out as jumps (trajectory_switches.h), and per
+  // sample whether the step into it is one of their steps (not a jump).
+  std::vector<SidewaysSwitch> switches;
+  std::vector<bool> switch_step;
 };
 
 // A step that departs from its neighbours' motion by more than threshold_m
 // (position) or threshold_rad (attitude), or by more than 8 times the
 // trajectory's median departure where that is larger, is a jump. A
-// threshold of 0 disables that part.
-DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
-                               double threshold_rad);
+// threshold of 0 disables that part. The sideways switches
+// (FindSidewaysSwitches with `switches`) are taken out as jumps spread over
+// their steps: their error steps there, as a jump's does.
+DejumpedTrajectory RemoveJumps(
+    const Trajectory& trajectory, double threshold_m, double threshold_rad,
+    const SidewaysSwitchOptions& switches = SidewaysSwitchOptions());
 
 // A jump where the GNSS returns after an outage (the stated sd grew before
 // it and falls back at it) is the closure of the INS's dead reckoning: the
