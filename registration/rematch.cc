@@ -118,23 +118,6 @@ std::string AdjustmentUnfitForRematch(const AdjustmentRecord* record,
   return "";
 }
 
-// Whether the vehicle travelled at most `gap_m` (horizontally, on
-// `trajectory`) between time `t` and one of the `sorted` times.
-bool NearAny(const std::vector<double>& sorted, double t,
-             const Trajectory& trajectory, double gap_m) {
-  Pose at;
-  if (!trajectory.InterpolatePose(t, &at)) return false;
-  const auto after = std::lower_bound(sorted.begin(), sorted.end(), t);
-  for (auto it : {after, after == sorted.begin() ? sorted.end() : after - 1}) {
-    Pose pose;
-    if (it != sorted.end() && trajectory.InterpolatePose(*it, &pose) &&
-        (pose.p_enu - at.p_enu).head<2>().norm() <= gap_m) {
-      return true;
-    }
-  }
-  return false;
-}
-
 // The seconds from `t` to the farther of the `sorted` times just before
 // and just after it (infinity unless there are both): between two line
 // points the lines bound the error on both sides; beyond the last one a
@@ -217,11 +200,20 @@ bool NearWithoutSidewaysMotion(const std::vector<double>& sorted, double t,
     Pose pose;
     if (it != sorted.end() && trajectory.InterpolatePose(*it, &pose) &&
         (pose.p_enu - at.p_enu).head<2>().norm() <= gap_m &&
-        std::abs(SidewaysMotion(trajectory, *it, t)) <= max_sideways_m) {
+        (std::isinf(max_sideways_m) ||
+         std::abs(SidewaysMotion(trajectory, *it, t)) <= max_sideways_m)) {
       return true;
     }
   }
   return false;
+}
+
+// Whether the vehicle travelled at most `gap_m` (horizontally, on
+// `trajectory`) between time `t` and one of the `sorted` times.
+bool NearAny(const std::vector<double>& sorted, double t,
+             const Trajectory& trajectory, double gap_m) {
+  return NearWithoutSidewaysMotion(sorted, t, trajectory, gap_m,
+                                   std::numeric_limits<double>::infinity());
 }
 
 // Drops the observations near no line point that the adjusted trajectory
