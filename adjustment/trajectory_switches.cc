@@ -31,9 +31,19 @@ std::vector<double> SmoothedTrack(const std::vector<double>& track,
   return smoothed;
 }
 
+// The sum of the sideways steps up to each sample, the taken ones left out.
+std::vector<double> SidewaysTrack(const std::vector<double>& side,
+                                  const std::vector<bool>& taken_steps) {
+  std::vector<double> track(side.size(), 0.0);
+  for (size_t i = 1; i < side.size(); ++i) {
+    track[i] = track[i - 1] + (taken_steps[i] ? 0.0 : side[i]);
+  }
+  return track;
+}
+
 // The slope (m/s) of `track` over the trend_s before (after) each sample,
 // NaN where the trajectory is shorter or a blocked sample (a gap, an
-// outage, a switch found already) lies in that window.
+// outage) lies in that window.
 struct Trends {
   std::vector<double> before;
   std::vector<double> after;
@@ -72,24 +82,25 @@ Trends TrackTrends(const std::vector<double>& track,
   return trends;
 }
 
-// The pair of unused samples (i < j) at most max_duration_s apart, with no
-// gap between them, over which `track` changes most beyond the sideways
-// trend around them: a steady crab or a slow drift moves the positions
-// sideways steadily, a switch steps between two stretches. The trend is
-// the smaller of the slopes before i and after j (the other may be a
-// neighbouring switch's), both required: near the ends of the trajectory
-// or of a blocked stretch nothing is found. Pairs sampled every `stride`
-// samples. Returns the change (0 when none).
+// The pair of samples (i < j) at most max_duration_s apart, with no gap
+// and no step of a switch found already between them, over which `track`
+// changes most beyond the sideways trend around them: a steady crab or a slow
+// drift moves the positions sideways steadily, a switch steps between two
+// stretches. The trend is the smaller of the slopes before i and after j (the
+// other may be a neighbouring switch's), both required: near the ends of the
+// trajectory or of a blocked stretch nothing is found. Pairs sampled every
+// `stride` samples. Returns the change (0 when none).
 double LargestChange(const std::vector<double>& track,
                      const std::vector<double>& times, const Trends& trends,
-                     const std::vector<bool>& blocked, int stride,
+                     const std::vector<bool>& blocked,
+                     const std::vector<bool>& taken_steps, int stride,
                      double max_duration_s, int* best_i, int* best_j) {
   const int n = static_cast<int>(track.size());
   double best = 0.0;
   for (int i = 0; i < n; i += stride) {
     if (blocked[i]) continue;
     for (int j = i + 1; j < n && times[j] - times[i] <= max_duration_s; ++j) {
-      if (blocked[j]) break;
+      if (blocked[j] || taken_steps[j]) break;
       if ((j - i) % stride != 0 && j + 1 < n) continue;
       // Both trends known, the smaller: the other may be a neighbouring
       // switch's.
@@ -209,24 +220,26 @@ std::vector<SidewaysSwitch> FindSidewaysSwitches(
   // The INS's yaw misalignment to the direction of travel moves the
   // positions sideways in proportion to the distance: not a switch.
   const double crab_rate = Median(crab);
-  std::vector<double> track(n, 0.0);
-  for (int i = 1; i < n; ++i) {
-    side[i] -= crab_rate * length[i];
-    track[i] = track[i - 1] + side[i];
-  }
-  const std::vector<double> smoothed =
-      SmoothedTrack(track, times, options.smoothing_s);
+  for (int i = 1; i < n; ++i) side[i] -= crab_rate * length[i];
   // Pairs sampled at about 20 Hz: a switch takes a second or more.
   const int stride = std::max(
       1, static_cast<int>(std::lround(0.05 / MedianSampleInterval(times))));
+  // The steps of the switches found so far are taken out of the track
+  // before the next is looked for, so that the trend over a window across
+  // one is the road's, not the switch's: switches a couple of seconds
+  // apart (multipath that comes and goes) are found one after the other.
+  std::vector<bool> taken_steps(n, false);
   std::vector<SidewaysSwitch> switches;
   for (int found = 0; found < n; ++found) {
+    const std::vector<double> smoothed = SmoothedTrack(
+        SidewaysTrack(side, taken_steps), times, options.smoothing_s);
     const Trends trends =
         TrackTrends(smoothed, times, blocked, options.trend_s);
     int i = -1;
     int j = -1;
-    const double change = LargestChange(smoothed, times, trends, blocked,
-                                        stride, options.max_duration_s, &i, &j);
+    const double change =
+        LargestChange(smoothed, times, trends, blocked, taken_steps, stride,
+                      options.max_duration_s, &i, &j);
     if (!(change >= options.min_switch_m)) break;
     SidewaysSwitch s;
     s.first = i;
@@ -234,9 +247,9 @@ std::vector<SidewaysSwitch> FindSidewaysSwitches(
     for (int k = i + 1; k <= j; ++k) {
       (*sideways_steps_enu)[k] = side[k] * right[k];
       s.size_m += side[k];
+      taken_steps[k] = true;
     }
     switches.push_back(s);
-    for (int k = i; k <= j; ++k) blocked[k] = true;
   }
   std::sort(switches.begin(), switches.end(),
             [](const SidewaysSwitch& a, const SidewaysSwitch& b) {

@@ -94,6 +94,33 @@ TEST(SidewaysSwitches, AMultipathSwitchIsFoundAndTakenOut) {
   EXPECT_NEAR(across, 1.0, 0.2);
 }
 
+// Multipath that comes and goes: three switches of 1 m, 2 s apart, the
+// trend windows around each reaching into its neighbours. Each is found,
+// its size within 10 cm, over its own step and none of its neighbours'
+// (seed 773 of the geometry sweep, where only the
+// middle one was, 42.5 -> 93.4 cm).
+TEST(SidewaysSwitches, SwitchesTwoSecondsApartAreEachFound) {
+  const Drive drive(
+      [](double t) {
+        return SmoothStep(t, 12.0, 13.5) - SmoothStep(t, 15.5, 17.0) +
+               SmoothStep(t, 19.0, 20.5);
+      },
+      false, 0.5, 0.02);
+  const std::vector<SidewaysSwitch> switches = Switches(drive);
+  ASSERT_EQ(switches.size(), 3u);
+  const double starts[] = {12.0, 15.5, 19.0};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(switches[k].size_m, k == 1 ? 1.0 : -1.0, 0.1) << k;
+    const double t0 = drive.samples[switches[k].first].time - 1000.0;
+    const double t1 = drive.samples[switches[k].last].time - 1000.0;
+    // Over the whole of its own step and none of its neighbours'.
+    EXPECT_LE(t0, starts[k]) << k;
+    EXPECT_GE(t1, starts[k] + 1.5) << k;
+    EXPECT_GT(t0, starts[k] - 2.0) << k;
+    EXPECT_LT(t1, starts[k] + 3.5) << k;
+  }
+}
+
 // A lane change (3.5 m over 4 s) moves the vehicle sideways along its own
 // heading: no switch. Nor is a 1 degree crab, nor 15 cm of noise at the
 // sample rate.
