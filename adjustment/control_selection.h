@@ -58,8 +58,13 @@ struct CrossingVerdict {
 // two_crossings_sigma_m (AdjustmentOptions::two_crossings_position_sigma_m)
 // on that axis.
 // `witnesses`: discrepancies of other control (whole dashes,
-// DashDiscrepancies) that vote in every test, on the axes they measure
-// (variance below kUnmeasuredVarianceM2), and are never rejected here.
+// DashDiscrepancies; the road lines across the track, LineDiscrepancies)
+// that vote in every test, on the axes they measure (variance below
+// kUnmeasuredVarianceM2), and are never rejected here. With witnesses
+// across the track (road lines) a lone crossing is tested too, against
+// those alone: a repainted crossing that is the only one matched is
+// otherwise control unchecked, and a whole dash, one mark matched alone,
+// is not enough to judge it.
 std::vector<CrossingVerdict> SelectConsistentCrossings(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<std::string>& names,

