@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <ctime>
+#include <limits>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -122,6 +123,37 @@ void RestoreThinnedEnds(const cv::Mat& bright,
   p.back() += back * gsd * out_back;
 }
 
+// Moves each end vertex of a lane line along the line to where its paint
+// ends at half contrast (HalfContrastEndRow), when the profile shows it;
+// otherwise leaves it (RestoreThinnedEnds put it there).
+void EndsAtHalfContrast(const cv::Mat& image, const cv::Mat& valid,
+                        const std::vector<cv::Point>& chain,
+                        const RoadRectification& rect, double min_contrast,
+                        RoadLine3d* line) {
+  std::vector<Eigen::Vector3d>& p = line->points_body;
+  if (p.size() < 2) return;
+  for (int outward : {-1, 1}) {
+    // Chains run top to bottom or bottom to top: which end is which row.
+    const bool front_is_top = chain.front().y <= chain.back().y;
+    const bool at_front = (outward < 0) == front_is_top;
+    Eigen::Vector3d& vertex = at_front ? p.front() : p.back();
+    const Eigen::Vector3d& inner = at_front ? p[1] : p[p.size() - 2];
+    const double end_row =
+        HalfContrastEndRow(image, valid, chain, outward, min_contrast);
+    Eigen::Vector2d xy_vertex, xy_inner;
+    if (!std::isfinite(end_row) ||
+        !rect.ProjectToRectified(0, vertex, &xy_vertex) ||
+        !rect.ProjectToRectified(0, inner, &xy_inner) ||
+        std::abs(xy_vertex.y() - xy_inner.y()) < 1.0) {
+      continue;
+    }
+    // The vertex slides along the line to the row of the paint's end.
+    const double t = (end_row - xy_vertex.y()) / (xy_vertex.y() - xy_inner.y());
+    if (std::abs(t * (xy_vertex.y() - xy_inner.y())) > 15.0) continue;
+    vertex += t * (vertex - inner);
+  }
+}
+
 double PolylineLength(const std::vector<Eigen::Vector3d>& points) {
   double length = 0.0;
   for (size_t i = 1; i < points.size(); ++i) {
@@ -140,6 +172,17 @@ std::string RoadLineOptions::Check() const {
     e << "max_range_m must exceed 1 m and max_lateral_m 0.5 m";
   } else if (median_window_px < 1 || median_window_px % 2 == 0) {
     e << "median_window_px must be odd and positive";
+  } else if (!(background_window_m == 0.0 ||
+               (background_window_m >= 2.0 * max_line_width_m &&
+                background_window_m <= 10.0))) {
+    e << "background_window_m must be 0 or in [2 x max_line_width_m, 10] m";
+  } else if (!(max_break_m >= 0.0 && max_break_m <= 2.0) ||
+             !(max_break_offset_m > 0.0 && max_break_offset_m <= 0.5)) {
+    e << "max_break_m must be in [0, 2] m and max_break_offset_m in (0, 0.5]";
+  } else if (!(min_end_contrast >= 0.0)) {
+    e << "min_end_contrast must be >= 0";
+  } else if (!(local_threshold_sigmas > 0.0) || !(shadow_sigmas > 0.0)) {
+    e << "local_threshold_sigmas and shadow_sigmas must be positive";
   } else if (!(threshold_sigmas > 0.0)) {
     e << "threshold_sigmas must be positive";
   } else if (!(min_line_width_m > 0.0 && max_line_width_m > min_line_width_m)) {
@@ -208,20 +251,29 @@ void StereoLineExtractor::LaneLines(const cv::Mat& left, const cv::Mat& right,
       1, static_cast<int>(std::floor(options_.min_line_width_m / gsd)));
   const int max_px =
       static_cast<int>(std::ceil(options_.max_line_width_m / gsd));
+  const int background_px =
+      static_cast<int>(std::lround(options_.background_window_m / gsd));
   cv::Mat bright[2];
   const cv::Mat* images[2] = {&left, &right};
   for (int side = 0; side < 2; ++side) {
-    bright[side] =
-        BrightLinePixels(*images[side], valid, options_.median_window_px,
-                         options_.threshold_sigmas, options_.plain_statistics);
+    bright[side] = BrightLinePixels(
+        *images[side], valid, options_.median_window_px,
+        options_.threshold_sigmas, options_.plain_statistics, background_px,
+        options_.local_threshold_sigmas, options_.shadow_sigmas);
     const int wide = KeepRunsByWidth(valid, min_px, max_px, &bright[side]);
     KeepRunsOnEvenGround(*images[side], options_.max_side_difference,
                          &bright[side]);
     if (side == 0) out->wide_runs = wide;
   }
-  const std::vector<std::vector<cv::Point>> chains =
+  std::vector<std::vector<cv::Point>> chains =
       FollowChains(ThinLines(bright[0]), options_.min_chain_px);
   out->chains += static_cast<int>(chains.size());
+  if (options_.max_break_m > 0.0) {
+    chains = JoinChainsAcrossBreaks(
+        std::move(chains),
+        static_cast<int>(std::lround(options_.max_break_m / gsd)),
+        options_.max_break_offset_m / gsd);
+  }
   const double sigma2 = options_.centre_sigma_px * options_.centre_sigma_px;
   const Eigen::Vector3d pixel_variance(sigma2, sigma2, sigma2);
   const int spacing_px = static_cast<int>(options_.max_vertex_spacing_m / gsd);
@@ -277,6 +329,10 @@ void StereoLineExtractor::LaneLines(const cv::Mat& left, const cv::Mat& right,
         options_, &line);
     if (line.points_body.size() < 2) continue;
     RestoreThinnedEnds(bright[0], chain, gsd, &line);
+    if (options_.half_contrast_ends) {
+      EndsAtHalfContrast(left, valid, chain, rect, options_.min_end_contrast,
+                         &line);
+    }
     const int margin = options_.median_window_px;
     const bool ends_seen = InsideValid(valid, chain.front(), margin) &&
                            InsideValid(valid, chain.back(), margin);

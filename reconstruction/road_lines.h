@@ -11,11 +11,14 @@
 //   1. per scan line, the mean and standard deviation of the gray values
 //      (valid pixels only); a pixel is bright when the 5-pixel median around
 //      it exceeds the mean by more than 1.5 standard deviations (binary
-//      image); runs of bright pixels wider or narrower than a painted line
-//      are cleared: zebra bands (0.5 m wide) are recognised here and left
-//      to the zebra front-end;
+//      image); in a shadow across the road, where the paint is darker than
+//      the sunlit asphalt that sets the mean, a local reference instead
+//      (bright_lines.h); runs of bright pixels wider or narrower than a
+//      painted line are cleared: zebra bands (0.5 m wide) are recognised
+//      here and left to the zebra front-end;
 //   2. thinning to one pixel (Zhang-Suen, OpenCV ximgproc);
 //   3. line following by chain coding; chains under 10 pixels dropped;
+//      chains joined across short breaks (a shadow's edge, worn paint);
 //   4. interior points collinear with their neighbours dropped (the
 //      polyline keeps a vertex at least every max_vertex_spacing_m, so the
 //      3D line keeps its height profile);
@@ -24,7 +27,10 @@
 //      search volume (a slab around the road plane); triangulated to the
 //      body frame with the covariance of the centres;
 //   6. 3D vertices: the triangulated points around each polyline vertex,
-//      averaged, with their covariance.
+//      averaged, with their covariance; the end vertices moved along the
+//      line to where the paint ends at half contrast, so a dash's two ends
+//      lie alike on its paint whatever the threshold and blur, and its
+//      centre, an along-track control point, is unbiased.
 // The scan lines of step 1 are image rows for lane lines; the same steps on
 // the columns (the transposed image) give stop lines, which lie along the
 // epipolar lines and so cannot be matched in stereo: their points are the
@@ -67,6 +73,17 @@ struct RoadLineOptions {
   // mean and deviation, which the paint of zebra bands crossing the scan
   // line raises over a stop line's contrast.
   bool plain_statistics = false;
+  // Lane lines in a shadow: the reference is the running median of this
+  // much of the scan line around each pixel, with its own deviation
+  // (bright_lines.h), where that median lies shadow_sigmas deviations
+  // under the scan line's: a shadow across the road hides the paint inside
+  // it from a reference set by the sunlit asphalt. Several times a lane
+  // line's width, under a zebra band's period. The local deviation is bare
+  // asphalt's, smaller than a whole scan line's, hence the higher
+  // threshold. 0: the scan line's statistics everywhere, as the seed.
+  double background_window_m = 1.2;
+  double local_threshold_sigmas = 2.5;
+  double shadow_sigmas = 1.5;
   // Widths of the bright runs kept across a lane line (along a row) and
   // across a stop line (along a column), metres on the road. Wider runs are
   // zebra bands or marks across the scan line; narrower ones noise.
@@ -82,6 +99,17 @@ struct RoadLineOptions {
   double max_side_difference = 0.5;
   // Step 3: shorter chains are dropped (the seed's 10 pixels).
   int min_chain_px = 10;
+  // Lane chains joined across breaks this short, when one continues the
+  // other within max_break_offset_m (bright_lines.h): a shadow's edge across
+  // a dash cuts it by about 0.45 m. Under the 1 m gaps of the shortest
+  // dashed patterns. 0: no joining.
+  double max_break_m = 0.6;
+  double max_break_offset_m = 0.06;
+  // A lane line's end vertices at its paint's end, half way in gray value
+  // from the paint to the ground beyond (road_lines.cc), when that step is
+  // at least min_end_contrast gray levels.
+  bool half_contrast_ends = true;
+  double min_end_contrast = 8.0;
   // Stop lines shorter than this across the road are dropped (the ends of
   // dashes and band sides cut by the image border look like short stop
   // lines).

@@ -8,15 +8,15 @@
 // dash seen whole (both ends inside the images: reconstruction/road_lines.h)
 // then places the vehicle along the track too.
 //
-// The reconstruction finds a dash's ends a little inside the paint (the end
-// vertex averages the points within a few pixels of the end): alike at
-// both ends, so the dash's CENTRE (the mid-point of its two ends) is the
-// observation, and its length tells a whole dash from one cut by an
-// occlusion or the image border.
+// The reconstruction finds a dash's ends where its paint ends at half
+// contrast, alike at both ends, so the dash's CENTRE (the mid-point of its
+// two ends) is the observation, and its length tells a whole dash from one
+// cut by an occlusion or the image border.
 //
 // A dash is matched to the database dash whose centre is nearest when
 //   - its length minus the database dash's lies in [min_length_difference_m,
-//     max_length_difference_m] (a cut dash is shorter by a metre or more);
+//     max_length_difference_m] (a cut dash is shorter, its centre off by
+//     half the cut);
 //   - its centre lies within gate_m of the database dash's centre along it
 //     (the trajectory's remaining error, which the caller sets from the
 //     posterior sd) and within max_across_m across it;
@@ -40,13 +40,14 @@ namespace zebrageo {
 
 struct DashMatchOptions {
   double max_dash_length_m = 6.5;
-  // Reconstructed minus database length: a whole dash seen by the road-line
-  // stage is about 0.2 m shorter than painted (its ends lie about 0.1 m
-  // inside the paint, the end vertices averaging the points within a few
-  // pixels of them); one cut by a vehicle or the image border is shorter by
-  // a metre or more.
-  double min_length_difference_m = -0.6;
-  double max_length_difference_m = 0.15;
+  // Reconstructed minus database length: the road-line stage puts a dash's
+  // ends where its paint ends at half contrast (reconstruction/
+  // road_lines.h), so a whole dash measures its painted length: within
+  // 0.15 m of it on rendered surveys (sd 0.08 m). One cut by a vehicle or
+  // the image border is shorter, and its centre off by half the cut: a
+  // cut over 0.3 m is refused. Longer by more than 0.3 m is two marks.
+  double min_length_difference_m = -0.3;
+  double max_length_difference_m = 0.3;
   double max_across_m = 0.4;
   double min_separation_ratio = 2.5;
 

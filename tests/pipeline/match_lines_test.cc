@@ -165,8 +165,9 @@ TEST_F(MatchLinesForAdjustmentTest, WithoutZebraControlTheLinesFindTheOffset) {
 
 // A dashed line 5.25 m to the left drawn dash by dash (3 m every 8 m), seen
 // from every exposure between 4 and 12 m ahead: a dash inside that range is
-// whole, reconstructed 0.2 m inside each painted end; one cut by the range
-// by a metre or more is shorter. Returns how many whole dashes were seen.
+// whole, its ends reconstructed 5 cm inside the painted ones (at half
+// contrast, reconstruction/road_lines.h); one cut by the range by a metre
+// or more is shorter. Returns how many whole dashes were seen.
 int AddDashes(AdjustmentData* data, std::vector<ReconstructedLinePoint>* points,
               double north_m) {
   for (double east = 0.0; east < 260.0; east += 8.0) {
@@ -192,8 +193,8 @@ int AddDashes(AdjustmentData* data, std::vector<ReconstructedLinePoint>* points,
       const double cut = (start - east) + (east + 3.0 - end);
       if (end - start < 1.0 || (cut > 0.0 && cut < 1.0)) continue;
       if (cut == 0.0) ++whole;
-      const double a = start + (start == east ? 0.2 : 0.0);
-      const double b = end - (end == east + 3.0 ? 0.2 : 0.0);
+      const double a = start + (start == east ? 0.05 : 0.0);
+      const double b = end - (end == east + 3.0 ? 0.05 : 0.0);
       ++line_id;
       for (int k = 0; k < 4; ++k) {
         ReconstructedLinePoint p;
@@ -225,7 +226,7 @@ TEST_F(MatchLinesForAdjustmentTest, WholeDashesControlTheAlongTrackPosition) {
     if (!c.along_track) continue;
     ++along;
     // The centre placed with the true pose lies on the database dash's
-    // centre along the dash (east), whatever the 0.2 m inset of its ends.
+    // centre along the dash (east), whatever the inset of its ends.
     const Eigen::Vector3d p_enu = TruePose(c.time).T_enu_body() * c.p_body;
     EXPECT_NEAR(std::abs(c.across_enu.x()), 1.0, 1e-6);
     EXPECT_NEAR((p_enu - c.db_point_enu).dot(c.across_enu), 0.0, 1e-3);

@@ -76,6 +76,74 @@ TEST(BrightLinePixels, RobustStatisticsKeepALineBesideZebraBands) {
   }
 }
 
+TEST(BrightLinePixels, LocalReferenceFindsALineInAShadow) {
+  // Sunlit asphalt (100) on the left 150 pixels, shadow (35) beyond, and
+  // a line in the shadow at 70: under the row's median.
+  cv::Mat image = NoisyBackground(4, 240, 2.0, 5);
+  image(cv::Rect(150, 0, 90, 4)) -= 65.0f;
+  image(cv::Rect(200, 0, 5, 4)) += 35.0f;
+  const cv::Mat row_reference = BrightLinePixels(image, cv::Mat(), 5, 1.5);
+  cv::Mat local = BrightLinePixels(image, cv::Mat(), 5, 1.5, false, 41);
+  // Noise sets a pixel here and there; a line is two pixels wide at least.
+  KeepRunsByWidth(cv::Mat(), 2, 10, &local);
+  for (int y = 0; y < 4; ++y) {
+    EXPECT_EQ(CountSet(row_reference, y, 195, 210), 0);
+    EXPECT_EQ(CountSet(local, y, 200, 205), 5);
+    // The shadow's edge is a step, not a bright run; nothing else is set.
+    EXPECT_EQ(CountSet(local, y, 0, 198) + CountSet(local, y, 207, 240), 0)
+        << "row " << y;
+  }
+}
+
+TEST(JoinChainsAcrossBreaks, JoinsAContinuationOnlyAndOnlyAUniqueOne) {
+  // A slanted line (1 column per 10 rows) broken at rows 40-51: written
+  // bottom to top (the join returns it top to bottom).
+  auto segment = [](int y0, int y1, double x0) {
+    std::vector<cv::Point> chain;
+    for (int y = y1; y >= y0; --y) {
+      chain.emplace_back(static_cast<int>(std::lround(x0 + 0.1 * y)), y);
+    }
+    return chain;
+  };
+  const auto upper = segment(0, 39, 20.0), lower = segment(52, 90, 20.0);
+  auto joined = JoinChainsAcrossBreaks({upper, lower}, 20, 2.0);
+  ASSERT_EQ(joined.size(), 1u);
+  EXPECT_EQ(joined[0].size(), upper.size() + lower.size());
+  EXPECT_EQ(joined[0].front().y, 0);
+  EXPECT_EQ(joined[0].back().y, 90);
+  // A gap too long, or a lower piece off the line's continuation: apart.
+  EXPECT_EQ(JoinChainsAcrossBreaks({upper, lower}, 10, 2.0).size(), 2u);
+  EXPECT_EQ(
+      JoinChainsAcrossBreaks({upper, segment(52, 90, 24.0)}, 20, 2.0).size(),
+      2u);
+  // Two pieces that could both continue it (a fork): no join at all.
+  EXPECT_EQ(
+      JoinChainsAcrossBreaks({upper, lower, segment(55, 95, 20.5)}, 20, 2.0)
+          .size(),
+      3u);
+}
+
+TEST(HalfContrastEndRow, FindsThePaintsEndsWhateverTheChainsLength) {
+  // A 5-pixel line painted over rows 20 to 59 and half of row 60 (gray 150
+  // on 50), blurred; its chain, as a threshold would leave it, from 24 to
+  // 57.
+  cv::Mat image(80, 40, CV_32F, cv::Scalar(50.0f));
+  image(cv::Rect(18, 20, 5, 40)).setTo(150.0f);
+  image.row(60).colRange(18, 23).setTo(100.0f);  // half a row of paint
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.5);
+  std::vector<cv::Point> chain;
+  for (int y = 24; y <= 57; ++y) chain.emplace_back(20, y);
+  const cv::Mat valid(image.size(), CV_8U, cv::Scalar(255));
+  // Row r covers [r - 0.5, r + 0.5]: the paint spans [19.5, 60.0].
+  EXPECT_NEAR(HalfContrastEndRow(image, valid, chain, -1, 8.0), 19.5, 0.1);
+  EXPECT_NEAR(HalfContrastEndRow(image, valid, chain, +1, 8.0), 60.0, 0.1);
+  // No step as strong as asked, or the ground beyond not valid: NaN.
+  EXPECT_TRUE(std::isnan(HalfContrastEndRow(image, valid, chain, 1, 200.0)));
+  cv::Mat cut = valid.clone();
+  cut.rowRange(62, 80).setTo(0);
+  EXPECT_TRUE(std::isnan(HalfContrastEndRow(image, cut, chain, 1, 8.0)));
+}
+
 TEST(KeepRunsByWidth, KeepsLineWidthsAndCountsBands) {
   cv::Mat binary = cv::Mat::zeros(3, 100, CV_8U);
   binary(cv::Rect(10, 0, 2, 3)).setTo(255);   // noise
@@ -212,7 +280,12 @@ double Paint(double x, double y) {
   return 0.0;
 }
 
-cv::Mat Render(const RigCamera& c, unsigned seed) {
+// A building's shadow over the right half of the road, its edge crossing
+// the dash x in [8, 11] at x = 9.5: the paint in it (0.35 x 210) is darker
+// than the sunlit asphalt (90) that sets a scan line's median.
+bool InShadow(double x, double y) { return y > 1.6 + 0.6 * (x - 9.5); }
+
+cv::Mat Render(const RigCamera& c, unsigned seed, bool shadow = false) {
   cv::Mat image(c.camera.height(), c.camera.width(), CV_32F);
   const Eigen::Matrix3d R = c.T_body_cam.linear();
   const Eigen::Vector3d o = c.T_body_cam.translation();
@@ -228,7 +301,8 @@ cv::Mat Render(const RigCamera& c, unsigned seed) {
           if (ray.z() <= 0) continue;
           const double t = (1.0 - o.z()) / ray.z();
           const Eigen::Vector3d p = o + t * ray;
-          sum += 0.25 * (90.0 + 120.0 * Paint(p.x(), p.y()));
+          const double light = shadow && InShadow(p.x(), p.y()) ? 0.35 : 1.0;
+          sum += 0.25 * light * (90.0 + 120.0 * Paint(p.x(), p.y()));
         }
       }
       image.at<float>(v, u) = static_cast<float>(sum);
@@ -284,6 +358,61 @@ TEST(StereoLineExtractor, RecoversLanesAndStopLineNotTheZebra) {
   EXPECT_GE(dashed, 1);
   EXPECT_EQ(stop, 1);
   EXPECT_GT(result.wide_runs, 50);  // the zebra bands, seen and left out
+}
+
+// The dash x in [8, 11] at y = 1.6 (body frame) among the lines of a pair:
+// its reconstructed extent along x, 0 when no dash lies there, and the
+// mid-point of its ends in `centre_x`.
+double ShadowedDashLength(const RoadLineOptions& options,
+                          double* centre_x = nullptr) {
+  const RigCamera left = MakeCamera("left", -0.5);
+  const RigCamera right = MakeCamera("right", 0.5);
+  RoadPlane road;
+  road.offset_m = 1.0;
+  const StereoLineExtractor extractor(left, right, road, options);
+  EXPECT_TRUE(extractor.ok()) << extractor.error();
+  const PairLines result =
+      extractor.Extract(Render(left, 3, true), Render(right, 4, true));
+  double longest = 0.0;
+  for (const RoadLine3d& line : result.lines) {
+    if (line.type != RoadLineType::kLaneDashed ||
+        line.points_body[0].y() < 0.0) {
+      continue;  // the solid line's far part, x in [..., 12.5]
+    }
+    double lo = 1e9, hi = -1e9;
+    for (const Eigen::Vector3d& p : line.points_body) {
+      EXPECT_NEAR(p.y(), 1.6, 0.03) << p.transpose();
+      lo = std::min(lo, p.x());
+      hi = std::max(hi, p.x());
+    }
+    if (lo > 7.5 && hi < 11.5 && hi - lo > longest) {
+      longest = hi - lo;
+      if (centre_x != nullptr) {
+        *centre_x =
+            0.5 * (line.points_body.front().x() + line.points_body.back().x());
+      }
+    }
+  }
+  return longest;
+}
+
+TEST(StereoLineExtractor, FindsADashWholeAcrossAShadowsEdge) {
+  // The local reference in the shadow and the joining across its edge:
+  // one whole dash, its ends at half contrast on the paint's ends: its
+  // length and centre (the along-track control point) within centimetres.
+  double centre_x = 0.0;
+  EXPECT_NEAR(ShadowedDashLength(RoadLineOptions(), &centre_x), 3.0, 0.1);
+  EXPECT_NEAR(centre_x, 9.5, 0.04);
+  // Ends as the vertex averaging leaves them: inside the paint (here by
+  // 5 cm each; by 0.1-0.2 m on rendered surveys, more blurred).
+  RoadLineOptions inside;
+  inside.half_contrast_ends = false;
+  EXPECT_LT(ShadowedDashLength(inside), 2.95);
+  // The seed's scan-line statistics lose the shadowed part of the dash.
+  RoadLineOptions seed;
+  seed.background_window_m = 0.0;
+  seed.max_break_m = 0.0;
+  EXPECT_LT(ShadowedDashLength(seed), 2.0);
 }
 
 TEST(ReconstructedLines, RoundTripAndClearErrors) {

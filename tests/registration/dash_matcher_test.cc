@@ -42,14 +42,15 @@ TEST(DatabaseDashes, OnlyShortLinesNamedDashes) {
 TEST(MatchDashes, AWholeDashGivesItsCentresOffsetAlongTheDash) {
   const auto db = Street();
   const auto db_dashes = DatabaseDashes(db, DashMatchOptions());
-  // The dash at x = 16..19, seen 0.4 m shorter (0.2 m in at each end),
-  // 0.15 m ahead and 0.1 m to the side.
-  const auto matches = MatchDashes({Seen(16.35, 18.95, 0.1, 0.3)}, db,
-                                   db_dashes, DashMatchOptions());
+  // The dash at x = 16..19, seen 0.1 m shorter (its ends at half contrast,
+  // within a few centimetres of the paint's), 0.15 m ahead and 0.1 m to the
+  // side.
+  const auto matches = MatchDashes({Seen(16.2, 19.1, 0.1, 0.3)}, db, db_dashes,
+                                   DashMatchOptions());
   ASSERT_EQ(matches.size(), 1u);
   EXPECT_EQ(db[matches[0].db_line].points.front().x(), 16.0);
   EXPECT_NEAR(matches[0].offset_m, 0.15, 1e-12);
-  EXPECT_NEAR(matches[0].length_difference_m, -0.4, 1e-12);
+  EXPECT_NEAR(matches[0].length_difference_m, -0.1, 1e-12);
   EXPECT_NEAR(matches[0].db_centre_enu.x(), 17.5, 1e-12);
   EXPECT_NEAR(std::abs(matches[0].along_enu.x()), 1.0, 1e-12);
 }
@@ -60,15 +61,17 @@ TEST(MatchDashes, RefusesCutDashesAndOffsetsBeyondTheGate) {
   const std::vector<ReconstructedDashEnu> seen = {
       // Cut by 1 m at one end: its centre is 0.5 m off.
       Seen(17.2, 18.8, 0.0, 1.0),
+      // Cut by 0.4 m (a wheel over its end): its centre is 0.2 m off.
+      Seen(16.4, 19.0, 0.0, 1.0),
       // Whole but 0.5 m ahead, with a 0.3 m gate.
-      Seen(16.7, 19.3, 0.0, 0.3),
+      Seen(16.5, 19.5, 0.0, 0.3),
       // Whole, but 0.5 m to the side.
-      Seen(16.2, 18.8, 0.5, 0.3),
+      Seen(16.0, 19.0, 0.5, 0.3),
       // Longer than painted.
       Seen(15.5, 19.5, 0.0, 0.3)};
   EXPECT_TRUE(MatchDashes(seen, db, db_dashes, DashMatchOptions()).empty());
   // The same second dash with a gate that allows it.
-  EXPECT_EQ(MatchDashes({Seen(16.7, 19.3, 0.0, 0.6)}, db, db_dashes,
+  EXPECT_EQ(MatchDashes({Seen(16.5, 19.5, 0.0, 0.6)}, db, db_dashes,
                         DashMatchOptions())
                 .size(),
             1u);
@@ -79,11 +82,11 @@ TEST(MatchDashes, RefusesADashHalfWayToTheNext) {
   const auto db_dashes = DatabaseDashes(db, DashMatchOptions());
   // 3 m ahead of the dash at 16..19 (5 m behind the one at 24..27): a
   // trajectory that far off would match either; with any gate, none.
-  EXPECT_TRUE(MatchDashes({Seen(19.2, 21.8, 0.0, 10.0)}, db, db_dashes,
+  EXPECT_TRUE(MatchDashes({Seen(19.0, 22.0, 0.0, 10.0)}, db, db_dashes,
                           DashMatchOptions())
                   .empty());
   // 1.2 m ahead: the next dash is 5.6 times farther.
-  EXPECT_EQ(MatchDashes({Seen(17.4, 20.0, 0.0, 1.5)}, db, db_dashes,
+  EXPECT_EQ(MatchDashes({Seen(17.2, 20.2, 0.0, 1.5)}, db, db_dashes,
                         DashMatchOptions())
                 .size(),
             1u);
