@@ -17,7 +17,8 @@ bool IsSet(const cv::Mat& mask, int x, int y) {
 namespace {
 
 // The median of `values` (reordered); values must not be empty.
-double MedianOf(std::vector<float>* values) {
+template <typename T>
+double MedianOf(std::vector<T>* values) {
   auto mid = values->begin() + values->size() / 2;
   std::nth_element(values->begin(), mid, values->end());
   return *mid;
@@ -316,6 +317,11 @@ double Sample(const cv::Mat& image, double x, double y) {
 
 }  // namespace
 
+bool RunsAcrossRows(const std::vector<cv::Point>& chain) {
+  const cv::Point d = chain.back() - chain.front();
+  return std::abs(d.y) >= 2 * std::abs(d.x);
+}
+
 ColumnFit FitColumns(const std::vector<cv::Point>& chain) {
   double sy = 0.0, sx = 0.0, syy = 0.0, sxy = 0.0;
   for (const cv::Point& p : chain) {
@@ -340,9 +346,9 @@ std::vector<std::vector<cv::Point>> JoinChainsAcrossBreaks(
   for (int i = 0; i < n; ++i) {
     std::vector<cv::Point>& c = chains[i];
     if (c.size() < 2) continue;
-    const cv::Point d = c.back() - c.front();
-    vertical[i] = std::abs(d.y) >= 2 * std::abs(d.x) && d.y != 0;
-    if (vertical[i] && d.y < 0) std::reverse(c.begin(), c.end());
+    const int dy = c.back().y - c.front().y;
+    vertical[i] = RunsAcrossRows(c) && dy != 0;
+    if (vertical[i] && dy < 0) std::reverse(c.begin(), c.end());
   }
   std::vector<ColumnFit> fits(n);
   for (int i = 0; i < n; ++i) {
@@ -485,11 +491,7 @@ double HalfContrastEndRow(const cv::Mat& image, const cv::Mat& valid,
       if (!std::isfinite(g)) return std::numeric_limits<double>::quiet_NaN();
     }
   }
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
-  const double paint = median(inside), ground = median(outside);
+  const double paint = MedianOf(&inside), ground = MedianOf(&outside);
   if (!(paint - ground > min_contrast)) {
     return std::numeric_limits<double>::quiet_NaN();
   }

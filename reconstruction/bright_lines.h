@@ -63,6 +63,12 @@ cv::Mat ThinLines(const cv::Mat& binary);
 std::vector<std::vector<cv::Point>> FollowChains(const cv::Mat& skeleton,
                                                  int min_length_px);
 
+// Step 1 finds marks running across the scan lines (the rows): a chain
+// must too, its ends at least twice as far apart across the rows as along
+// them. Noise elongated along the rows (far away, one original pixel
+// covers several rectified ones along the road) is dropped.
+bool RunsAcrossRows(const std::vector<cv::Point>& chain);
+
 // x = x0 + slope * y fitted to a chain's pixels by least squares (the
 // thinned end pixels may hook along a shadow's edge: the fit does not).
 struct ColumnFit {

@@ -29,15 +29,6 @@ bool InsideValid(const cv::Mat& valid, const cv::Point& p, int radius) {
   return true;
 }
 
-// Step 1 finds marks running across the scan lines (the rows): a chain
-// must too, its ends at least twice as far apart across the rows as along
-// them. Noise elongated along the rows (far away, one original pixel
-// covers several rectified ones along the road) is dropped.
-bool RunsAcrossRows(const std::vector<cv::Point>& chain) {
-  const cv::Point d = chain.back() - chain.front();
-  return std::abs(d.y) >= 2 * std::abs(d.x);
-}
-
 // Rows of paint beyond a chain's end pixel `end`, away from `inner` (a
 // chain pixel a few steps in), in the bright mask: what the thinning took
 // off that end. Zhang-Suen's thinning is not symmetric (its first
