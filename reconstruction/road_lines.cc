@@ -202,6 +202,8 @@ std::string RoadLineOptions::Check() const {
     e << "max_dash_length_m must be positive";
   } else if (!(stop_line_height_sigma_m > 0.0)) {
     e << "stop_line_height_sigma_m must be positive";
+  } else if (crossing_edges.enabled) {
+    e << crossing_edges.Check();
   }
   const std::string error = e.str();
   return error.empty() ? error : "road line options: " + error;
@@ -229,6 +231,7 @@ PairLines StereoLineExtractor::Extract(const cv::Mat& left_image,
   rectification_.Rectify(left_image, right_image, &left, &right);
   LaneLines(left, right, &out);
   StopLines(left, &out);
+  if (options_.crossing_edges.enabled) CrossingEdges(left, right, &out);
   out.seconds = ThreadCpuSeconds() - start;
   return out;
 }
@@ -268,43 +271,16 @@ void StereoLineExtractor::LaneLines(const cv::Mat& left, const cv::Mat& right,
   const double sigma2 = options_.centre_sigma_px * options_.centre_sigma_px;
   const Eigen::Vector3d pixel_variance(sigma2, sigma2, sigma2);
   const int spacing_px = static_cast<int>(options_.max_vertex_spacing_m / gsd);
-  const double h = options_.max_height_off_road_m;
   for (const std::vector<cv::Point>& chain : chains) {
     if (!RunsAcrossRows(chain)) continue;
     std::vector<ChainPoint> points;
     for (int i = 0; i < static_cast<int>(chain.size()); ++i) {
       const int y = chain[i].y;
-      double x_left = 0.0;
-      if (!RunCentre(left, bright[0], y, chain[i].x, &x_left)) continue;
-      // The search volume: the residual disparities of the slab.
-      Eigen::Vector3d on_road;
-      if (!road_.IntersectRay(rect.left_centre_body(),
-                              rect.RayBody(0, Eigen::Vector2d(x_left, y)),
-                              &on_road)) {
+      double x_left = 0.0, x_right = 0.0;
+      if (!RunCentre(left, bright[0], y, chain[i].x, &x_left) ||
+          !RightRunCentre(right, bright[1], x_left, y, max_px, &x_right)) {
         continue;
       }
-      const double d1 = rect.DisparityOf(on_road - h * road_.normal_body);
-      const double d2 = rect.DisparityOf(on_road + h * road_.normal_body);
-      if (!std::isfinite(d1) || !std::isfinite(d2)) continue;
-      const double lo = x_left - std::max(d1, d2);
-      const double hi = x_left - std::min(d1, d2);
-      // The one right run whose centre is in [lo, hi].
-      const uint8_t* b = bright[1].ptr<uint8_t>(y);
-      int found = 0;
-      double x_right = 0.0;
-      const int from = std::max(0, static_cast<int>(std::floor(lo)) - max_px);
-      const int to =
-          std::min(right.cols - 1, static_cast<int>(std::ceil(hi)) + max_px);
-      for (int x = from; x <= to; ++x) {
-        if (b[x] == 0 || (x > from && b[x - 1] != 0)) continue;
-        double centre = 0.0;
-        if (RunCentre(right, bright[1], y, x, &centre) && centre >= lo &&
-            centre <= hi) {
-          ++found;
-          x_right = centre;
-        }
-      }
-      if (found != 1) continue;
       ChainPoint point;
       point.index = i;
       if (!rect.Triangulate(x_left, x_right, y, &point.p)) continue;
@@ -333,6 +309,42 @@ void StereoLineExtractor::LaneLines(const cv::Mat& left, const cv::Mat& right,
                     : RoadLineType::kLaneSolid;
     if (Finish(&line)) out->lines.push_back(std::move(line));
   }
+}
+
+bool StereoLineExtractor::RightRunCentre(const cv::Mat& right,
+                                         const cv::Mat& bright_right,
+                                         double x_left, int y, int max_px,
+                                         double* x_right) const {
+  const RoadRectification& rect = rectification_;
+  const double h = options_.max_height_off_road_m;
+  // The search volume: the residual disparities of the slab.
+  Eigen::Vector3d on_road;
+  if (!road_.IntersectRay(rect.left_centre_body(),
+                          rect.RayBody(0, Eigen::Vector2d(x_left, y)),
+                          &on_road)) {
+    return false;
+  }
+  const double d1 = rect.DisparityOf(on_road - h * road_.normal_body);
+  const double d2 = rect.DisparityOf(on_road + h * road_.normal_body);
+  if (!std::isfinite(d1) || !std::isfinite(d2)) return false;
+  const double lo = x_left - std::max(d1, d2);
+  const double hi = x_left - std::min(d1, d2);
+  // The one right run whose centre is in [lo, hi].
+  const uint8_t* b = bright_right.ptr<uint8_t>(y);
+  int found = 0;
+  const int from = std::max(0, static_cast<int>(std::floor(lo)) - max_px);
+  const int to =
+      std::min(right.cols - 1, static_cast<int>(std::ceil(hi)) + max_px);
+  for (int x = from; x <= to; ++x) {
+    if (b[x] == 0 || (x > from && b[x - 1] != 0)) continue;
+    double centre = 0.0;
+    if (RunCentre(right, bright_right, y, x, &centre) && centre >= lo &&
+        centre <= hi) {
+      ++found;
+      *x_right = centre;
+    }
+  }
+  return found == 1;
 }
 
 void StereoLineExtractor::StopLines(const cv::Mat& left, PairLines* out) const {
@@ -420,9 +432,10 @@ bool StereoLineExtractor::Finish(RoadLine3d* line) const {
 std::string RoadLineSummary::BriefReport() const {
   std::ostringstream out;
   out << lines << " road lines (" << lines_of_type[0] << " solid, "
-      << lines_of_type[1] << " dashed, " << lines_of_type[2] << " stop lines), "
-      << points << " points from " << pairs << " stereo pairs, "
-      << 1e3 * seconds_per_pair << " ms CPU per pair";
+      << lines_of_type[1] << " dashed, " << lines_of_type[2] << " stop lines, "
+      << lines_of_type[3] << " crossing edges), " << points << " points from "
+      << pairs << " stereo pairs, " << 1e3 * seconds_per_pair
+      << " ms CPU per pair";
   return out.str();
 }
 
@@ -481,6 +494,8 @@ RoadLineSummary ExtractSurveyLines(
         }
       }
       if (!read) continue;
+      VLOG(3) << "road lines: exposure " << exposure.exposure_id << " pair "
+              << p;
       results[e][p] = extractors[p]->Extract(images[0], images[1]);
       ran[e][p] = true;
     }

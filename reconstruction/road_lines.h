@@ -35,7 +35,9 @@
 // the columns (the transposed image) give stop lines, which lie along the
 // epipolar lines and so cannot be matched in stereo: their points are the
 // left rays intersected with the road plane, the covariance carrying the
-// plane's height uncertainty.
+// plane's height uncertainty. The edges of zebra crossings seen in part
+// (the seen ends of their bands, crossing_edges.h) are found in the same
+// rectified pair (road_lines_edges.cc).
 //
 // Frames: body (FRD) metres for every 3D output; image coordinates of the
 // outputs are pixels of the ORIGINAL (distorted) images, (0, 0) the centre
@@ -51,6 +53,7 @@
 #include <vector>
 
 #include "reconstruction/bright_lines.h"
+#include "reconstruction/crossing_edges.h"
 #include "reconstruction/road_rectification.h"
 #include "survey/results_lines.h"
 #include "survey/rig.h"
@@ -136,6 +139,9 @@ struct RoadLineOptions {
   double max_dash_length_m = 5.0;
   // Stop lines: height uncertainty of the road plane they are put on.
   double stop_line_height_sigma_m = 0.03;
+  // The seen ends of zebra bands, one line per crossing edge
+  // (crossing_edges.h), put on the road plane like stop lines.
+  CrossingEdgeOptions crossing_edges;
 
   std::string Check() const;
 };
@@ -179,6 +185,21 @@ class StereoLineExtractor {
   void LaneLines(const cv::Mat& left, const cv::Mat& right,
                  PairLines* out) const;
   void StopLines(const cv::Mat& left, PairLines* out) const;
+  // The centre of the one bright run of `bright_right` in row y inside the
+  // search volume of the left centre x_left (step 5).
+  bool RightRunCentre(const cv::Mat& right, const cv::Mat& bright_right,
+                      double x_left, int y, int max_px, double* x_right) const;
+  void CrossingEdges(const cv::Mat& left, const cv::Mat& right,
+                     PairLines* out) const;
+  // Keeps the points of `line` whose height over the road plane is within
+  // max_difference_m of their median (two: within half of it of their
+  // mean).
+  void DropEndsOffTheRoad(double max_difference_m, RoadLine3d* line) const;
+  // A band end's point in 3D: the band's centre line triangulated over the
+  // rows inside its end, extrapolated to the end (crossing_edges.h).
+  bool StereoEndPoint(const BandEnd& end, const cv::Mat* images,
+                      const cv::Mat* paint, Eigen::Vector3d* p,
+                      Eigen::Matrix3d* covariance) const;
   bool Finish(RoadLine3d* line) const;  // uv, false if not projectable
 
   RigCamera cameras_[2];
@@ -196,7 +217,7 @@ class StereoLineExtractor {
 struct RoadLineSummary {
   int pairs = 0;
   int lines = 0;
-  int lines_of_type[3] = {0, 0, 0};
+  int lines_of_type[kRoadLineTypes] = {0, 0, 0, 0};
   int points = 0;
   double seconds_per_pair = 0.0;  // CPU
   std::string BriefReport() const;

@@ -30,7 +30,9 @@ RoadLineType TypeOf(const CsvTable& csv, int row) {
   if (type == "lane_solid") return RoadLineType::kLaneSolid;
   if (type == "lane_dashed") return RoadLineType::kLaneDashed;
   if (type == "stop_line") return RoadLineType::kStopLine;
-  csv.Fail(row, "type must be lane_solid, lane_dashed or stop_line");
+  if (type == "crossing_edge") return RoadLineType::kCrossingEdge;
+  csv.Fail(row,
+           "type must be lane_solid, lane_dashed, stop_line or crossing_edge");
 }
 
 // The value of `key` in `object` as T; throws InputError naming the key.
@@ -57,6 +59,8 @@ const char* RoadLineTypeName(RoadLineType type) {
       return "lane_dashed";
     case RoadLineType::kStopLine:
       return "stop_line";
+    case RoadLineType::kCrossingEdge:
+      return "crossing_edge";
   }
   return "lane_solid";
 }

@@ -24,7 +24,11 @@ inline constexpr char kReconstructedLinesFile[] = "reconstructed_lines.csv";
 inline constexpr char kLineMatchesFile[] = "line_matches.csv";
 inline constexpr char kLineControlFile[] = "line_control.json";
 
-enum class RoadLineType { kLaneSolid, kLaneDashed, kStopLine };
+// kCrossingEdge: the seen ends of a zebra crossing's bands, one line across
+// them (reconstruction/crossing_edges.h); its points are ordered so that,
+// seen from above, the paint lies to the left of the way they run.
+enum class RoadLineType { kLaneSolid, kLaneDashed, kStopLine, kCrossingEdge };
+inline constexpr int kRoadLineTypes = 4;
 const char* RoadLineTypeName(RoadLineType type);  // lane_solid, ...
 
 // reconstructed_lines.csv: one row per vertex of a line seen in one pair.

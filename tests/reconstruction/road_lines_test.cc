@@ -327,6 +327,7 @@ TEST(StereoLineExtractor, RecoversLanesAndStopLineNotTheZebra) {
   for (const RoadLine3d& line : result.lines) {
     ASSERT_EQ(line.points_body.size(), line.covariances_body.size());
     ASSERT_EQ(line.points_body.size(), line.uv_left.size());
+    if (line.type == RoadLineType::kCrossingEdge) continue;  // below
     for (size_t k = 0; k < line.points_body.size(); ++k) {
       const Eigen::Vector3d& p = line.points_body[k];
       const Eigen::Matrix3d& c = line.covariances_body[k];
@@ -358,6 +359,62 @@ TEST(StereoLineExtractor, RecoversLanesAndStopLineNotTheZebra) {
   EXPECT_GE(dashed, 1);
   EXPECT_EQ(stop, 1);
   EXPECT_GT(result.wide_runs, 50);  // the zebra bands, seen and left out
+}
+
+TEST(StereoLineExtractor, CrossingEdgesOnTheBandsEndsPaintOnTheLeft) {
+  const RigCamera left = MakeCamera("left", -0.5);
+  const RigCamera right = MakeCamera("right", 0.5);
+  RoadPlane road;
+  road.offset_m = 1.0;
+  // The crossing lies 12 m ahead of the cameras: beyond the default range
+  // of crossing edges (11 m), none.
+  for (const RoadLine3d& line :
+       StereoLineExtractor(left, right, road, RoadLineOptions())
+           .Extract(Render(left, 1), Render(right, 2))
+           .lines) {
+    EXPECT_NE(line.type, RoadLineType::kCrossingEdge);
+  }
+  RoadLineOptions options;
+  options.crossing_edges.max_end_range_m = 14.0;
+  const StereoLineExtractor extractor(left, right, road, options);
+  ASSERT_TRUE(extractor.ok()) << extractor.error();
+  const PairLines result = extractor.Extract(Render(left, 1), Render(right, 2));
+  // The crossing's bands run x 13..16: its near edge (the paint ahead of
+  // it). The far one lies on the rectification's range limit (16 m): the
+  // ground beyond it is not seen, so it may be the view's end, not the
+  // paint's.
+  int near_edges = 0, far_edges = 0;
+  for (const RoadLine3d& line : result.lines) {
+    if (line.type != RoadLineType::kCrossingEdge) continue;
+    ASSERT_GE(line.points_body.size(), 3u);
+    const bool near = line.points_body[0].x() < 14.5;
+    near_edges += near;
+    far_edges += !near;
+    double mean_x = 0.0;
+    for (size_t k = 0; k < line.points_body.size(); ++k) {
+      const Eigen::Vector3d& p = line.points_body[k];
+      const Eigen::Matrix3d& c = line.covariances_body[k];
+      SCOPED_TRACE(::testing::Message() << "edge point " << p.transpose());
+      // 13 m ahead of cameras 2.5 m up, a centimetre of stereo height is
+      // 5 cm along the road: within 3 sd of its own covariance, which is
+      // under 15 cm.
+      EXPECT_NEAR(p.x(), 13.0, 3.0 * std::sqrt(c(0, 0)));
+      EXPECT_LT(std::sqrt(c(0, 0)), 0.15);
+      mean_x += p.x() / line.points_body.size();
+      // At a band's centre (bands where fmod(y, 1) < 0.5).
+      EXPECT_NEAR(std::fmod(p.y() + 100.0, 1.0), 0.25, 0.03);
+      EXPECT_NEAR(p.z(), 1.0, 0.03);
+      EXPECT_GT(c.determinant(), 0.0);
+    }
+    EXPECT_NEAR(mean_x, 13.0, 0.03);
+    // Seen from above, the paint to the left of the way the points run:
+    // in FRD left of (dx, dy) is (dy, -dx); the paint is +x of the near
+    // edge, -x of the far one.
+    const Eigen::Vector3d d = line.points_body.back() - line.points_body[0];
+    EXPECT_GT((near ? 1.0 : -1.0) * d.y(), 0.0);
+  }
+  EXPECT_EQ(near_edges, 1);
+  EXPECT_EQ(far_edges, 0);
 }
 
 // The dash x in [8, 11] at y = 1.6 (body frame) among the lines of a pair:
