@@ -128,6 +128,65 @@ LateralOffset Decide(std::vector<Vote> votes,
   return out;
 }
 
+// The shift within continuity_m of `reference` most points vote for, when
+// at least min_continuity_points do: decided by continuity.
+bool DecideNear(const std::vector<Vote>& votes, double reference,
+                const LateralOffsetOptions& options, LateralOffset* window) {
+  const int steps =
+      static_cast<int>(std::floor(options.continuity_m / options.bin_m));
+  double best_points = 0.0, best_offset = reference;
+  for (int k = -steps; k <= steps; ++k) {
+    const double offset = reference + k * options.bin_m;
+    const double points = PointsNear(votes, offset, options, nullptr, nullptr);
+    if (points > best_points) {
+      best_points = points;
+      best_offset = offset;
+    }
+  }
+  if (best_points < options.min_continuity_points) return false;
+  std::vector<double> offsets;
+  window->points =
+      PointsNear(votes, best_offset, options, &window->spread_m, &offsets);
+  window->offset_m = offsets.empty() ? best_offset : Median(offsets);
+  window->decided =
+      std::abs(window->offset_m - reference) <= options.continuity_m;
+  return window->decided;
+}
+
+// Undecided windows next to decided ones (by index, at most
+// continuity_windows apart), nearest first, until none changes.
+void DecideByContinuity(const std::vector<std::vector<Vote>>& votes,
+                        const std::vector<int64_t>& index,
+                        const LateralOffsetOptions& options,
+                        std::vector<LateralOffset>* windows) {
+  for (int gap = 1; gap <= options.continuity_windows; ++gap) {
+    bool changed = true;
+    while (changed) {
+      changed = false;
+      for (size_t w = 0; w < windows->size(); ++w) {
+        if ((*windows)[w].decided) continue;
+        // The decided neighbours `gap` windows away or nearer: one, or two
+        // that agree.
+        std::vector<double> references;
+        for (size_t v = 0; v < windows->size(); ++v) {
+          const int64_t d = std::abs(index[v] - index[w]);
+          if (v != w && (*windows)[v].decided && d <= gap) {
+            references.push_back((*windows)[v].offset_m);
+          }
+        }
+        if (references.empty()) continue;
+        const auto [lo, hi] =
+            std::minmax_element(references.begin(), references.end());
+        if (*hi - *lo > options.continuity_m) continue;
+        if (DecideNear(votes[w], Median(references), options, &(*windows)[w])) {
+          (*windows)[w].by_continuity = gap;
+          changed = true;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::string LateralOffsetOptions::Check() const {
@@ -137,6 +196,10 @@ std::string LateralOffsetOptions::Check() const {
       !(min_spread_m >= 0.0)) {
     e << "max_offset_m, window_s, bin_m, tolerance_m and min_separation_m "
          "must be positive, min_spread_m not negative";
+  } else if (continuity_windows < 0 || !(continuity_m >= 0.0) ||
+             !(min_continuity_points >= 1.0)) {
+    e << "continuity_windows and continuity_m must not be negative, "
+         "min_continuity_points at least 1";
   } else if (!(min_ratio >= 1.0) || min_points < 1) {
     e << "min_ratio must be at least 1 and min_points at least 1";
   } else if (max_offset_m / bin_m > 1e5) {
@@ -165,10 +228,20 @@ std::vector<LateralOffset> SearchLateralOffsets(
     VotesOf(points[i], static_cast<int>(i), left_of[i], database, grid, options,
             &near, &votes);
   }
+  std::vector<std::vector<Vote>> kept;
+  std::vector<int64_t> index;
   for (auto& [w, votes] : windows) {
-    LateralOffset offset = Decide(std::move(votes), options);
+    std::sort(votes.begin(), votes.end(), [](const Vote& a, const Vote& b) {
+      return a.offset_m < b.offset_m;
+    });
+    LateralOffset offset = Decide(votes, options);
     offset.start_s = start + w * options.window_s;
     out.push_back(offset);
+    kept.push_back(std::move(votes));
+    index.push_back(w);
+  }
+  if (options.continuity_windows > 0) {
+    DecideByContinuity(kept, index, options, &out);
   }
   return out;
 }

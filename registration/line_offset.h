@@ -38,6 +38,18 @@ struct LateralOffsetOptions {
   int min_points = 10;
   // The voting points' spread across the road: two painted lines apart.
   double min_spread_m = 1.0;
+  // Continuity: a window left undecided takes the shift within
+  // continuity_m of a decided window at most continuity_windows away (the
+  // nearest; its own such neighbours in turn), when at least
+  // min_continuity_points agree on it. A GNSS/INS cross-track error moves
+  // by centimetres between windows, painted lines lie a metre and more
+  // apart: the lane a window alone could not tell (one line in view, or
+  // lanes alike) is the one next to its neighbour's. A sudden switch (a
+  // metre in a few seconds) leaves no votes that near, and the window
+  // undecided. 0 windows: no continuity.
+  int continuity_windows = 3;
+  double continuity_m = 0.2;
+  double min_continuity_points = 5.0;
 
   std::string Check() const;
 };
@@ -51,6 +63,9 @@ struct LateralOffset {
   double points = 0.0;
   double runner_up_points = 0.0;
   double spread_m = 0.0;
+  // Decided by continuity with the window that many windows away (0: by
+  // its own votes).
+  int by_continuity = 0;
 };
 
 // Per window holding points (time order). `time_of[i]` and `left_of[i]`

@@ -304,6 +304,45 @@ TEST(SearchLateralOffsets, OneLineAloneDecidesNothing) {
   for (const LateralOffset& w : found.windows) EXPECT_FALSE(w.decided);
 }
 
+// Once the lines together decided the shift, one line alone keeps it in
+// the next windows (continuity), but not across a sudden 1 m switch.
+TEST(SearchLateralOffsets, OneLineKeepsTheShiftByContinuityNotAcrossASwitch) {
+  const Eigen::Vector3d drift(0.3, -1.6, 0.0);
+  const Eigen::Vector3d switched(0.3, -2.6, 0.0);
+  SeenStreet seen;
+  seen.Add(Seen(1, "lane_solid", -3.2, 1, 19, drift));
+  seen.Add(Seen(2, "lane_solid", 3.2, 1, 19, drift));
+  seen.Add(Seen(3, "lane_solid", -3.2, 20, 59, drift));
+  seen.Add(Seen(4, "lane_solid", -3.2, 60, 99, switched));
+  const std::vector<Eigen::Vector2d> left(seen.points.size(),
+                                          Eigen::Vector2d::UnitY());
+  const std::vector<LateralOffset> windows = SearchLateralOffsets(
+      seen.points, seen.time, left, Street(), LateralOffsetOptions());
+  ASSERT_GE(windows.size(), 5u);
+  int by_continuity = 0;
+  for (const LateralOffset& w : windows) {
+    SCOPED_TRACE(::testing::Message() << "window at " << w.start_s);
+    if (w.start_s < 6.0) {  // (the window at 4.1 s ends 2 dm switched)
+      EXPECT_TRUE(w.decided);
+      EXPECT_NEAR(w.offset_m, 1.6, 0.02);
+      EXPECT_EQ(w.by_continuity > 0, w.start_s > 1.0);
+      by_continuity += w.by_continuity > 0;
+    } else {
+      EXPECT_FALSE(w.decided);
+    }
+  }
+  EXPECT_GE(by_continuity, 2);
+  // Without continuity only the first window is decided.
+  LateralOffsetOptions alone;
+  alone.continuity_windows = 0;
+  int decided = 0;
+  for (const LateralOffset& w :
+       SearchLateralOffsets(seen.points, seen.time, left, Street(), alone)) {
+    decided += w.decided;
+  }
+  EXPECT_EQ(decided, 1);
+}
+
 TEST(LateralOffsetOptions, CheckNamesTheProblem) {
   LateralOffsetOptions options;
   EXPECT_EQ(options.Check(), "");
