@@ -333,5 +333,12 @@ bool RoadLinesOnly(const AdjustmentOptions& options, const State& state) {
                       });
 }
 
+bool AlongTrackHeld(const AdjustmentOptions& options, const State& state) {
+  return RoadLinesOnly(options, state) &&
+         std::none_of(
+             state.lines.begin(), state.lines.end(),
+             [](const State::Line& line) { return line.point.along_track; });
+}
+
 }  // namespace adjustment_internal
 }  // namespace zebrageo

@@ -42,6 +42,11 @@ void FitPositionModel(const Context& context,
 // point left, matched line points, and line_control_without_crossings.
 bool RoadLinesOnly(const AdjustmentOptions& options, const State& state);
 
+// Whether the along-track correction is held at the input's
+// (State::along_track_held): road lines alone, none of them holding the
+// position along the track (a crossing's edge does, a lane line does not).
+bool AlongTrackHeld(const AdjustmentOptions& options, const State& state);
+
 }  // namespace adjustment_internal
 }  // namespace zebrageo
 

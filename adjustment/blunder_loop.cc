@@ -29,8 +29,9 @@ bool AdjustmentSolver::Adjust() {
       // The last crossing rejected: the road lines alone hold the
       // trajectory now, solved as when none had been matched (SelectControl):
       // along the track nothing measures it (a height misfit on a grade
-      // would move it by metres), and the position process is the lines'.
-      state_->along_track_held = true;
+      // would move it by metres) unless crossing edges do, and the position
+      // process is the lines'.
+      state_->along_track_held = AlongTrackHeld(options, *state_);
       FitPositionModel(context_, {}, *state_, &state_->model);
       adjustment_internal::ResetState(state_);
       if (!SolveTwice()) return false;

@@ -109,7 +109,7 @@ void SelectControl(const Context& context, const CrossingTable& crossings,
   state->model =
       adjustment_internal::InitialErrorModel(context, discrepancies, *state);
   state->along_track_held =
-      adjustment_internal::RoadLinesOnly(context.options, *state);
+      adjustment_internal::AlongTrackHeld(context.options, *state);
 }
 
 }  // namespace

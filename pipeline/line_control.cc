@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "pipeline/edge_control.h"
 #include "pipeline/stages.h"
 #include "reconstruction/road_lines.h"
 #include "registration/dash_matcher.h"
@@ -29,40 +30,6 @@ namespace {
 // The database line's slope is fitted over +-10 m: the height of a control
 // point follows it when the adjustment moves the point along the line.
 constexpr double kGradeHalfWindowM = 10.0;
-
-// The corrected body pose at `time` (InterpolatePoses, as Trajectory does:
-// linear in position, slerp in attitude between the corrected samples);
-// false outside them.
-bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
-  const auto& samples = result.corrected_samples;
-  if (samples.size() < 2 || time < samples.front().time ||
-      time > samples.back().time) {
-    return false;
-  }
-  const auto it = std::upper_bound(
-      samples.begin(), samples.end(), time,
-      [](double t, const TrajectorySample& s) { return t < s.time; });
-  const size_t i = std::min<size_t>(
-      std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
-  const double span = samples[i + 1].time - samples[i].time;
-  const double u = span > 0.0 ? (time - samples[i].time) / span : 0.0;
-  *pose = InterpolatePoses(result.corrected_poses[i],
-                           result.corrected_poses[i + 1], u);
-  return true;
-}
-
-// The posterior horizontal sd (radial) of the corrected trajectory at
-// `time`: from the nearest corrected sample (its sd_* are the posterior
-// ones when the adjustment computed them).
-double PosteriorSdAt(const AdjustmentResult& result, double time) {
-  const auto& samples = result.corrected_samples;
-  if (samples.empty()) return 0.0;
-  const auto it = std::lower_bound(
-      samples.begin(), samples.end(), time,
-      [](const TrajectorySample& s, double t) { return s.time < t; });
-  const TrajectorySample& s = it == samples.end() ? samples.back() : *it;
-  return std::hypot(s.sd_enu_m.x(), s.sd_enu_m.y());
-}
 
 // Database lines whose matched points lie, by their median, further from
 // where the zebra-corrected trajectory puts them than
@@ -164,7 +131,8 @@ void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
     VLOG(1) << "  window at " << o.start_s << " s: offset " << o.offset_m
             << " m, " << o.points << " points against " << o.runner_up_points
             << ", spread " << o.spread_m << " m"
-            << (o.decided ? "" : " (undecided)");
+            << (o.decided ? "" : " (undecided)")
+            << (o.by_continuity > 0 ? " (by continuity)" : "");
   }
   *points = std::move(kept);
 }
@@ -363,6 +331,40 @@ void LogLineControl(size_t used, size_t reconstructed, double stretch_s,
 
 }  // namespace
 
+// The corrected body pose at `time` (InterpolatePoses, as Trajectory does:
+// linear in position, slerp in attitude between the corrected samples);
+// false outside them.
+bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
+  const auto& samples = result.corrected_samples;
+  if (samples.size() < 2 || time < samples.front().time ||
+      time > samples.back().time) {
+    return false;
+  }
+  const auto it = std::upper_bound(
+      samples.begin(), samples.end(), time,
+      [](double t, const TrajectorySample& s) { return t < s.time; });
+  const size_t i = std::min<size_t>(
+      std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
+  const double span = samples[i + 1].time - samples[i].time;
+  const double u = span > 0.0 ? (time - samples[i].time) / span : 0.0;
+  *pose = InterpolatePoses(result.corrected_poses[i],
+                           result.corrected_poses[i + 1], u);
+  return true;
+}
+
+// The posterior horizontal sd (radial) of the corrected trajectory at
+// `time`: from the nearest corrected sample (its sd_* are the posterior
+// ones when the adjustment computed them).
+double PosteriorSdAt(const AdjustmentResult& result, double time) {
+  const auto& samples = result.corrected_samples;
+  if (samples.empty()) return 0.0;
+  const auto it = std::lower_bound(
+      samples.begin(), samples.end(), time,
+      [](const TrajectorySample& s, double t) { return s.time < t; });
+  const TrajectorySample& s = it == samples.end() ? samples.back() : *it;
+  return std::hypot(s.sd_enu_m.x(), s.sd_enu_m.y());
+}
+
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
     const AdjustmentResult& zebra_result,
@@ -370,12 +372,17 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     const std::string& results_folder, std::vector<std::string>* warnings) {
   std::vector<LineControlPoint> control;
   if (reconstructed_lines == nullptr) return control;
+  // Crossing edges are matched to the database's crossings, apart.
+  std::vector<ReconstructedLinePoint> points, edge_points;
+  for (const ReconstructedLinePoint& p : *reconstructed_lines) {
+    (p.type == RoadLineType::kCrossingEdge ? edge_points : points).push_back(p);
+  }
   if (data.roadmarks.lines.empty()) {
     warnings->push_back(
         "the road-mark database has no lines: road lines not used");
-    return control;
+    if (edge_points.empty()) return control;
+    points.clear();
   }
-  const std::vector<ReconstructedLinePoint>& points = *reconstructed_lines;
   std::unordered_map<int64_t, double> exposure_time;
   for (const Exposure& e : data.exposures.exposures) {
     exposure_time[e.exposure_id] = e.time;
@@ -464,6 +471,14 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
       stretches[static_cast<int>(
           std::floor((control[i].time - start_time) / stretch_s))][2] += 1;
     }
+  }
+  // Along the track too: the edges of crossings never seen whole.
+  const size_t first_edge = control.size();
+  AddCrossingEdgeControl(data, options, zebra_result, edge_points,
+                         exposure_time, &control, &rows);
+  for (size_t i = first_edge; i < control.size(); ++i) {
+    stretches[static_cast<int>(
+        std::floor((control[i].time - start_time) / stretch_s))][2] += 1;
   }
   LogLineControl(matches.size(), points.size(), stretch_s, stretches);
   if (results_folder.empty()) return control;

@@ -274,6 +274,73 @@ TEST_F(MatchLinesForAdjustmentTest, NoDashOutsideTheAlongTrackGate) {
   }
 }
 
+// A crossing's near edge seen from the exposure at 9 s (the bands of
+// 3 m from east 100, across north -2.5..2.5; seen 0.2 m east of where the
+// database draws it): along-track control across the edge, unless the
+// zebra front-end reconstructed the crossing's bands (it is control, or
+// was refused) or the paint is on the wrong side.
+TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
+  for (int b = 0; b < 5; ++b) {
+    RoadmarkBand band;
+    band.crossing_id = "Z1";
+    band.band = b + 1;
+    band.sigma_xy_m = 0.05;
+    band.sigma_z_m = 0.1;
+    const double n0 = 2.0 - b, n1 = n0 + 0.5;
+    const Eigen::Vector3d corners[4] = {{100, n0, 0}, {103, n0, 0},
+                                        {103, n1, 0}, {100, n1, 0}};
+    for (int k = 0; k < 4; ++k) {
+      band.corners[k] = data_.frame.GeodeticFromEnu(corners[k]);
+    }
+    data_.roadmarks.bands.push_back(band);
+  }
+  const Pose pose = TruePose(9.0);
+  // The paint is east of the near edge: running south, it is on the left.
+  auto edge = [&](bool paint_on_the_left) {
+    std::vector<ReconstructedLinePoint> points;
+    for (int b = 0; b < 4; ++b) {
+      ReconstructedLinePoint p;
+      p.exposure_id = 1018;
+      p.line_id = 9000;
+      p.type = RoadLineType::kCrossingEdge;
+      p.point = b;
+      const double north = paint_on_the_left ? 2.25 - b : -0.75 + b;
+      p.p_body = pose.T_enu_body().inverse() * Eigen::Vector3d(100.2, north, 0);
+      p.covariance_body = Eigen::Matrix3d::Identity() * 1e-4;
+      points.push_back(p);
+    }
+    return points;
+  };
+  auto edge_control = [&](const std::vector<ReconstructedLinePoint>& points) {
+    std::vector<std::string> warnings;
+    std::vector<LineControlPoint> along;
+    for (const LineControlPoint& c : MatchLinesForAdjustment(
+             data_, AdjustmentOptions(), zebra_, &points, "", &warnings)) {
+      if (c.along_track) along.push_back(c);
+    }
+    return along;
+  };
+  const std::vector<LineControlPoint> control = edge_control(edge(true));
+  ASSERT_EQ(control.size(), 4u);
+  for (const LineControlPoint& c : control) {
+    EXPECT_NEAR(c.across_enu.x(), 1.0, 1e-6);
+    EXPECT_NEAR(c.across_enu.dot(pose.T_enu_body() * c.p_body - c.db_point_enu),
+                0.2, 1e-6);
+    // At most what the database's sd allows for the whole edge.
+    EXPECT_LT(c.sqrt_information(0, 0), 1.0 / (0.05 * std::sqrt(4.0)) + 1e-9);
+    EXPECT_EQ(c.sqrt_information(1, 0), 0.0);
+    EXPECT_EQ(c.sqrt_information(1, 1), 0.0);
+  }
+  EXPECT_TRUE(edge_control(edge(false)).empty());
+  // Its bands reconstructed (from the exposure at 8.5 s): left out.
+  ReconstructedVertex vertex;
+  vertex.exposure_id = 1017;
+  vertex.p_body =
+      TruePose(8.5).T_enu_body().inverse() * Eigen::Vector3d(101.0, 0.25, 0);
+  data_.vertices.push_back(vertex);
+  EXPECT_TRUE(edge_control(edge(true)).empty());
+}
+
 TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
   std::vector<std::string> warnings;
   EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
