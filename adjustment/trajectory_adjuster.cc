@@ -195,9 +195,13 @@ AdjustmentResult AdjustTrajectory(
                               !state.lines.empty();
   if (summary.line_control_only) {
     context.Warn(
-        "no zebra crossing is control: road lines alone correct the "
-        "trajectory across them and in height; the along-track position is "
-        "the input's");
+        state.along_track_held
+            ? "no zebra crossing is control: road lines alone correct the "
+              "trajectory across them and in height; the along-track "
+              "position is the input's"
+            : "no zebra crossing is control: road lines correct the "
+              "trajectory across them and in height, the edges of crossings "
+              "seen in part along the track");
   }
   summary.time_in_seconds = Seconds(start);
   summary.usable = true;

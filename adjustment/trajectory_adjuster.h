@@ -400,7 +400,7 @@ struct AdjustmentSummary {
   bool covariance_computed = false;
   // Whether the trajectory was corrected (else the poses are the input's),
   // and whether road lines were its only control (no zebra crossing: the
-  // along-track position is the input's).
+  // along-track position is the input's unless crossing edges hold it).
   bool corrected = false;
   bool line_control_only = false;
 

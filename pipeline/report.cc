@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -216,12 +217,21 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
   if (data.decisions.empty() || matched == 0) {
     const bool lines_only = data.adjustment.is_object() &&
                             data.adjustment.value("road_lines_only", false);
+    // Along the track: the edges of crossings seen in part, if any.
+    const bool along =
+        lines_only && DashesControl(report->value("road_lines", json()),
+                                    -std::numeric_limits<double>::infinity(),
+                                    std::numeric_limits<double>::infinity());
     warnings.push_back(
-        lines_only ? "no zebra crossing was matched: road lines alone "
-                     "control the trajectory, across them and in height; "
-                     "along-track it is the input's"
-                   : "no zebra crossing was matched: the trajectory is not "
-                     "controlled anywhere");
+        !lines_only ? "no zebra crossing was matched: the trajectory is not "
+                      "controlled anywhere"
+        : along     ? "no zebra crossing was matched: road lines alone "
+                      "control the trajectory across them and in height, and "
+                      "the edges of crossings seen in part along the track "
+                      "(line_matches.csv, constrains along)"
+                    : "no zebra crossing was matched: road lines alone "
+                      "control the trajectory, across them and in height; "
+                      "along-track it is the input's");
   }
   for (json& s : (*report)["uncontrolled_stretches"]) {
     const bool lines = RoadLinesControl(report->value("road_lines", json()),
@@ -241,8 +251,9 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
          << " to " << s["end_time_s"].get<double>() << " s) by zebra crossings"
          << (!lines   ? ""
              : dashes ? "; road lines control cross-track and height there, "
-                        "along-track only where whole dashes were matched "
-                        "(line_matches.csv, constrains along)"
+                        "along-track only where whole dashes or crossing "
+                        "edges were matched (line_matches.csv, constrains "
+                        "along)"
                       : "; road lines control cross-track and height there, "
                         "along-track is not controlled");
     warnings.push_back(text.str());
