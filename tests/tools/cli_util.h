@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -46,6 +47,40 @@ inline std::vector<std::string> FilesUnder(const std::string& folder) {
     }
   }
   return files;
+}
+
+// ../shared/tools/score_results.py (independent of zebrageo; it picks its
+// own python3) beside the repository.
+inline std::string Scorer() {
+  return std::string(ZEBRAGEO_SHARED_DIR) + "/tools/score_results.py";
+}
+
+// score_results.py MODE SURVEY RESULTS FLAGS: whether it passed (exit 0)
+// and what it printed (also written to `out_path`).
+struct Score {
+  bool passed = false;
+  std::string text;
+};
+inline Score ScoreResults(const std::string& mode, const std::string& survey,
+                          const std::string& results, const std::string& flags,
+                          const std::string& out_path) {
+  const int status = std::system(
+      ("python3 " + Quote(Scorer()) + " " + mode + " " + Quote(survey) + " " +
+       Quote(results) + " " + flags + " > " + Quote(out_path) + " 2>&1")
+          .c_str());
+  Score score;
+  score.passed = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  score.text = ReadWholeFile(out_path);
+  return score;
+}
+
+// The horizontal RMSE after ("after: H 4.3 cm") of score_results.py poses,
+// metres; -1 when absent.
+inline double HorizontalAfterM(const std::string& poses_output) {
+  std::smatch match;
+  const std::regex after(R"(after: H ([0-9.]+) cm)");
+  if (!std::regex_search(poses_output, match, after)) return -1.0;
+  return 0.01 * std::stod(match[1].str());
 }
 
 // A small survey (80 m, 2 crossings, 640x480 images, ~20 exposures) that

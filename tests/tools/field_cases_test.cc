@@ -29,10 +29,6 @@ std::string CaseFolder(const std::string& name) {
   return datasets.empty() ? "" : datasets + "/field-cases/" + name;
 }
 
-std::string Scorer() {
-  return std::string(ZEBRAGEO_SHARED_DIR) + "/tools/score_results.py";
-}
-
 // One run per case per process, in a folder that lives as long as it.
 struct CaseRun {
   int code = -1;
@@ -55,34 +51,15 @@ const CaseRun& RunOf(const std::string& name) {
   return run;
 }
 
-// score_results.py MODE with `flags` on a case's run: its exit status and
-// its output.
-struct Score {
-  bool passed = false;
-  std::string text;
-};
+// score_results.py MODE with `flags` on a case's run.
 Score ScoreRun(const std::string& mode, const std::string& name,
                const std::string& flags) {
   static TemporaryFolder folder;
-  const std::string out = folder.Path(mode + "-" + name + ".out");
-  const int status =
-      std::system(("python3 " + Quote(Scorer()) + " " + mode + " " +
-                   Quote(CaseFolder(name)) + " " + Quote(RunOf(name).results) +
-                   " " + flags + " > " + Quote(out) + " 2>&1")
-                      .c_str());
-  Score score;
-  score.passed = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  score.text = ReadWholeFile(out);
+  const Score score =
+      ScoreResults(mode, CaseFolder(name), RunOf(name).results, flags,
+                   folder.Path(mode + "-" + name + ".out"));
   std::cout << "[  SCORE   ] " << name << " " << mode << ": " << score.text;
   return score;
-}
-
-// The horizontal RMSE after ("after: H 4.3 cm"), metres.
-double HorizontalAfterM(const std::string& poses_output) {
-  std::smatch match;
-  const std::regex after(R"(after: H ([0-9.]+) cm)");
-  if (!std::regex_search(poses_output, match, after)) return -1.0;
-  return 0.01 * std::stod(match[1].str());
 }
 
 class FieldCase : public ::testing::TestWithParam<std::string> {
