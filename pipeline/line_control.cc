@@ -463,20 +463,15 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   // Along the track: whole dashes, once the crossings corrected the
   // trajectory (without them its along-track error is unbounded, and a
   // dash period off would match the next dash).
+  const size_t first_along = control.size();
   if (zebra_result.summary.corrected) {
-    const size_t first_dash = control.size();
     AddDashControl(points, line_points, matches, database, zebra_result,
                    options, &control, &rows);
-    for (size_t i = first_dash; i < control.size(); ++i) {
-      stretches[static_cast<int>(
-          std::floor((control[i].time - start_time) / stretch_s))][2] += 1;
-    }
   }
   // Along the track too: the edges of crossings never seen whole.
-  const size_t first_edge = control.size();
   AddCrossingEdgeControl(data, options, zebra_result, edge_points,
                          exposure_time, &control, &rows);
-  for (size_t i = first_edge; i < control.size(); ++i) {
+  for (size_t i = first_along; i < control.size(); ++i) {
     stretches[static_cast<int>(
         std::floor((control[i].time - start_time) / stretch_s))][2] += 1;
   }

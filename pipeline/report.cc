@@ -174,9 +174,10 @@ bool RoadLinesControl(const json& road_lines, double t0, double t1) {
   return overlapping > 0 && 2 * controlled > overlapping;
 }
 
-// Whether whole lane-line dashes held the along-track position in a
-// stretch of line_control.json overlapping [t0, t1].
-bool DashesControl(const json& road_lines, double t0, double t1) {
+// Whether road lines (whole lane-line dashes, crossing edges) held the
+// along-track position in a stretch of line_control.json overlapping
+// [t0, t1].
+bool AlongTrackLinesControl(const json& road_lines, double t0, double t1) {
   if (!road_lines.is_object()) return false;
   const double length = road_lines.value("stretch_s", 0.0);
   for (const json& s : road_lines.value("stretches", json::array())) {
@@ -219,9 +220,10 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
                             data.adjustment.value("road_lines_only", false);
     // Along the track: the edges of crossings seen in part, if any.
     const bool along =
-        lines_only && DashesControl(report->value("road_lines", json()),
-                                    -std::numeric_limits<double>::infinity(),
-                                    std::numeric_limits<double>::infinity());
+        lines_only &&
+        AlongTrackLinesControl(report->value("road_lines", json()),
+                               -std::numeric_limits<double>::infinity(),
+                               std::numeric_limits<double>::infinity());
     warnings.push_back(
         !lines_only ? "no zebra crossing was matched: the trajectory is not "
                       "controlled anywhere"
@@ -240,22 +242,22 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
     s["road_lines_control_cross_track_and_height"] = lines;
     // The stretches of line_control.json are coarser than this one: dashes
     // there may lie outside it.
-    const bool dashes =
-        lines && DashesControl(report->value("road_lines", json()),
-                               s["start_time_s"].get<double>(),
-                               s["end_time_s"].get<double>());
+    const bool along =
+        lines && AlongTrackLinesControl(report->value("road_lines", json()),
+                                        s["start_time_s"].get<double>(),
+                                        s["end_time_s"].get<double>());
     std::ostringstream text;
     text.precision(0);
     text << std::fixed << "no control over " << s["length_m"].get<double>()
          << " m of trajectory (t = " << s["start_time_s"].get<double>()
          << " to " << s["end_time_s"].get<double>() << " s) by zebra crossings"
-         << (!lines   ? ""
-             : dashes ? "; road lines control cross-track and height there, "
-                        "along-track only where whole dashes or crossing "
-                        "edges were matched (line_matches.csv, constrains "
-                        "along)"
-                      : "; road lines control cross-track and height there, "
-                        "along-track is not controlled");
+         << (!lines  ? ""
+             : along ? "; road lines control cross-track and height there, "
+                       "along-track only where whole dashes or crossing "
+                       "edges were matched (line_matches.csv, constrains "
+                       "along)"
+                     : "; road lines control cross-track and height there, "
+                       "along-track is not controlled");
     warnings.push_back(text.str());
   }
   if (data.adjustment.is_object() && data.adjustment.contains("sigma0") &&

@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "reconstruction/bright_lines.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
@@ -88,8 +88,8 @@ cv::Mat BandPaintPixels(const cv::Mat& image, const cv::Mat& valid, double gsd,
   KeepRunsByWidth(
       valid, std::max(1, static_cast<int>(options.min_band_width_m / gsd)),
       static_cast<int>(std::ceil(options.max_band_width_m / gsd)), &paint);
-  // Sunlit asphalt beside a shadow's edge is brighter than the window's
-  // mean too, but its two sides differ.
+  // Sunlit asphalt beside a shadow's edge is over the shadowed ground too,
+  // but its two sides differ.
   KeepRunsOnEvenGround(image, options.max_side_difference, &paint);
   return paint;
 }
@@ -213,9 +213,7 @@ std::vector<BandEnd> FindBandEnds(const cv::Mat& image, const cv::Mat& valid,
         std::abs(axis.c1) > options.max_axis_slope) {
       continue;
     }
-    std::nth_element(widths.begin(), widths.begin() + widths.size() / 2,
-                     widths.end());
-    const double width = widths[widths.size() / 2];
+    const double width = Median(widths);
     for (int outward : {-1, 1}) {
       BandEnd end;
       if (EndOfBand(image, valid, labels, label, box, axis.c0, axis.c1, width,
