@@ -47,7 +47,7 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--bad", args->bad,
                   "write a small broken survey of this kind for the "
                   "bad-input suite (truth/meta.json says what to expect; "
-                  "kinds in README.md)");
+                  "kinds in docs/input-checks.md)");
   sub->add_option("--max-road-length", args->max_road_length_m,
                   "random preset: the longest road drawn, metres (from 60)")
       ->capture_default_str();

@@ -161,7 +161,7 @@ TEST_P(BadSurvey, RunEndsCleanlyAsExpected) {
       << "NaN in a message";
   const std::string& expected = ExpectedMessages().at(kind.name);
   if (kind.expect == "error") {
-    // 1: invalid input (README.md, "Exit status").
+    // 1: invalid input (docs/cli.md, "Exit status").
     EXPECT_EQ(code, 1);
     const std::string last = LastLine(err);
     EXPECT_TRUE(Contains(last, "^zebrageo: error: ")) << last;
