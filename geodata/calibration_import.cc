@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "geodata/text_input.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
 #include "survey/yaml_document.h"
@@ -25,12 +26,20 @@ int LineOf(const YAML::Node& node) {
   return node.IsDefined() ? YamlLine(node) : 0;
 }
 
+// The file's text: never more than a calibration file can be (a device
+// such as /dev/zero is refused, not read for ever), never binary data.
 std::string ReadText(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, std::string("cannot read the ") + what);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return ReadTextInput(path, what, kMaxCalibrationFileBytes);
+}
+
+// A YAML document whose top level is a mapping, or "not a <what>".
+YAML::Node ReadYamlMapping(const std::string& path, const char* what) {
+  const YAML::Node root = ParseYamlDocument(ReadText(path, what), path);
+  if (!root.IsMap()) {
+    throw InputError(
+        path, 1, std::string("not a ") + what + ": expected a YAML mapping");
+  }
+  return root;
 }
 
 // Numbers of a flat list, or of a list of lists (Kalibr writes 4x4 as
@@ -189,13 +198,17 @@ struct RosCamera {
   Eigen::Matrix3d R_rect_cam;
   Eigen::Matrix<double, 3, 4> P;
   YAML::Node projection_node;
+  int size_line = 0;  // of image_width
 };
 
 RosCamera ReadRosCamera(const std::string& path, const std::string& name,
                         const CalibrationImportOptions& options) {
-  const YAML::Node root =
-      ParseYamlDocument(ReadText(path, "ROS camera_info file"), path);
-  if (!root.IsMap()) throw InputError(path, 1, "expected a YAML mapping");
+  const YAML::Node root = ReadYamlMapping(path, "ROS camera_info file");
+  if (!root["image_width"] && !root["camera_matrix"]) {
+    throw InputError(path, 1,
+                     "not a ROS camera_info file: no image_width or "
+                     "camera_matrix");
+  }
   const int width = RequiredInt(root, "image_width", path);
   const int height = RequiredInt(root, "image_height", path);
   auto data = [&](const std::string& key, size_t size) {
@@ -232,6 +245,7 @@ RosCamera ReadRosCamera(const std::string& path, const std::string& name,
                      "projection_matrix must have fx', fy' > 0");
   }
   ros.projection_node = root["projection_matrix"];
+  ros.size_line = LineOf(root["image_width"]);
   return ros;
 }
 
@@ -293,10 +307,11 @@ Rig ImportKalibrCamchain(const std::string& path,
                          const CalibrationImportOptions& options) {
   const std::string error = options.Check();
   if (!error.empty()) throw std::invalid_argument(error);
-  const YAML::Node root =
-      ParseYamlDocument(ReadText(path, "Kalibr camchain file"), path);
-  if (!root.IsMap() || !root["cam0"]) {
-    throw InputError(path, 1, "expected a Kalibr camchain with 'cam0'");
+  const YAML::Node root = ReadYamlMapping(path, "Kalibr camchain file");
+  if (!root["cam0"]) {
+    throw InputError(path, 1,
+                     "not a Kalibr camchain file: no 'cam0' (a camchain "
+                     "names its cameras cam0, cam1, ...)");
   }
   int count = 0;
   while (root["cam" + std::to_string(count)]) ++count;
@@ -351,10 +366,29 @@ Rig ImportKalibrCamchain(const std::string& path,
       T_body_cam = T_body_previous * IsometryOf(R, translation).inverse();
     }
     T_body_previous = T_body_cam;
+    if (n % 2 == 1 && (width != rig.cameras.back().camera.width() ||
+                       height != rig.cameras.back().camera.height())) {
+      throw InputError(
+          path, LineOf(cam["resolution"]),
+          key + ": resolution " + std::to_string(width) + "x" +
+              std::to_string(height) + " differs from cam" +
+              std::to_string(n - 1) + "'s " +
+              std::to_string(rig.cameras.back().camera.width()) + "x" +
+              std::to_string(rig.cameras.back().camera.height()) +
+              ": the two cameras of a stereo pair must have the same "
+              "image size");
+    }
     rig.cameras.push_back(
         {Camera(name, width, height, intrinsics[0], intrinsics[1],
                 intrinsics[2], intrinsics[3], distortion),
          T_body_cam});
+  }
+  // After the cameras, so that an error in cam0 is named first.
+  if (count < 2) {
+    throw InputError(path, LineOf(root["cam0"]),
+                     "the camchain has cam0 only: a stereo rig needs 'cam1' "
+                     "too (calibrate both cameras together with "
+                     "kalibr_calibrate_cameras)");
   }
   for (int n = 0; n + 1 < count; n += 2) rig.stereo_pairs.push_back({n, n + 1});
   return rig;
@@ -368,6 +402,17 @@ Rig ImportRosCameraInfoPair(const std::string& left_path,
   if (!error.empty()) throw std::invalid_argument(error);
   const RosCamera left = ReadRosCamera(left_path, "left", options);
   const RosCamera right = ReadRosCamera(right_path, "right", options);
+  if (left.camera.width() != right.camera.width() ||
+      left.camera.height() != right.camera.height()) {
+    throw InputError(
+        right_path, right.size_line,
+        "image_width/image_height " + std::to_string(right.camera.width()) +
+            "x" + std::to_string(right.camera.height()) + " differ from " +
+            left_path + "'s " + std::to_string(left.camera.width()) + "x" +
+            std::to_string(left.camera.height()) +
+            ": the two cameras of a stereo pair must have the same image "
+            "size");
+  }
   // Offsets of the two rectified cameras, from P's fourth column.
   const Eigen::Vector3d b_rect(
       right.P(0, 3) / right.P(0, 0) - left.P(0, 3) / left.P(0, 0),

@@ -4,6 +4,7 @@
 
 #include <GeographicLib/UTMUPS.hpp>
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -299,30 +300,38 @@ void WriteMetashapeMarkers(const std::vector<GroundControlPoint>& gcps,
                            const std::string& path,
                            const std::string& projections_path) {
   // Metashape's Reference import reads delimited columns in an order chosen
-  // in its dialog; the header comment names them for it.
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "# zebrageo ground control; CRS " << crs.header << "\n";
-    out << "# label,x,y,z,x_accuracy,y_accuracy,z_accuracy,enabled\n";
-    for (const GroundControlPoint& gcp : gcps) {
-      const Eigen::Vector3d xyz = crs.from_wgs84(gcp.position);
-      const int decimals = HorizontalDecimals(xyz);
-      out << gcp.name << "," << Fixed(xyz.x(), decimals) << ","
-          << Fixed(xyz.y(), decimals) << "," << Fixed(xyz.z(), 4) << ","
-          << FormatDouble(gcp.sigma_xy_m) << "," << FormatDouble(gcp.sigma_xy_m)
-          << "," << FormatDouble(gcp.sigma_z_m) << ","
-          << (gcp.role == GcpRole::kControl ? 1 : 0) << "\n";
+  // in its dialog; the header comment names them for it. Both files are
+  // written before either is renamed into place: a failure leaves neither.
+  AtomicFile markers(path);
+  std::ostream& out = markers.stream();
+  out << "# zebrageo ground control; CRS " << crs.header << "\n";
+  out << "# label,x,y,z,x_accuracy,y_accuracy,z_accuracy,enabled\n";
+  for (const GroundControlPoint& gcp : gcps) {
+    const Eigen::Vector3d xyz = crs.from_wgs84(gcp.position);
+    const int decimals = HorizontalDecimals(xyz);
+    out << gcp.name << "," << Fixed(xyz.x(), decimals) << ","
+        << Fixed(xyz.y(), decimals) << "," << Fixed(xyz.z(), 4) << ","
+        << FormatDouble(gcp.sigma_xy_m) << "," << FormatDouble(gcp.sigma_xy_m)
+        << "," << FormatDouble(gcp.sigma_z_m) << ","
+        << (gcp.role == GcpRole::kControl ? 1 : 0) << "\n";
+  }
+  AtomicFile projections(projections_path);
+  std::ostream& projection_out = projections.stream();
+  projection_out << "# marker,image,x,y (pixels, (0,0) the centre of the "
+                    "top-left pixel)\n";
+  for (const GroundControlPoint& gcp : gcps) {
+    for (const GcpObservation& o : gcp.observations) {
+      projection_out << gcp.name << "," << o.image_name << ","
+                     << Fixed(o.uv.x(), 3) << "," << Fixed(o.uv.y(), 3) << "\n";
     }
-  });
-  WriteFileAtomically(projections_path, [&](std::ostream& out) {
-    out << "# marker,image,x,y (pixels, (0,0) the centre of the top-left "
-           "pixel)\n";
-    for (const GroundControlPoint& gcp : gcps) {
-      for (const GcpObservation& o : gcp.observations) {
-        out << gcp.name << "," << o.image_name << "," << Fixed(o.uv.x(), 3)
-            << "," << Fixed(o.uv.y(), 3) << "\n";
-      }
-    }
-  });
+  }
+  projections.Commit();
+  try {
+    markers.Commit();
+  } catch (...) {
+    std::remove(projections_path.c_str());
+    throw;
+  }
 }
 
 }  // namespace zebrageo

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "geodata/gps_time.h"
+#include "geodata/text_input.h"
 #include "geodata/trajectory_import.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
@@ -154,11 +155,14 @@ std::vector<TrajectorySample> ReadNovatelAscii(const std::string& path) {
   if (!in) throw InputError(path, 0, "cannot read the NovAtel log");
   std::vector<TrajectorySample> samples;
   double first_week = -1.0;
+  // A record is a few hundred bytes: a longer line, or binary data, is not
+  // a NovAtel ASCII log (a binary log, /dev/zero).
+  constexpr size_t kMaxLineBytes = 1 << 16;
+  BoundedLineReader reader(&in, path, "NovAtel ASCII log",
+                           kMaxTrajectoryTextBytes, kMaxLineBytes);
   std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+  while (reader.Next(&line)) {
+    const int line_number = reader.line_number();
     const bool extended = line.rfind("#INSPVAXA,", 0) == 0;
     const bool plain = line.rfind("#INSPVAA,", 0) == 0;
     if (!extended && !plain) {
@@ -175,7 +179,9 @@ std::vector<TrajectorySample> ReadNovatelAscii(const std::string& path) {
     samples.push_back(record.sample);
   }
   if (samples.empty()) {
-    throw InputError(path, 0, "no #INSPVAXA or #INSPVAA record");
+    throw InputError(path, 0,
+                     "not a NovAtel ASCII log: no #INSPVAXA or #INSPVAA "
+                     "record");
   }
   CheckImportedSamples(samples, path, "line");
   return samples;

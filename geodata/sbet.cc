@@ -27,28 +27,60 @@ double LittleEndianDouble(const unsigned char* bytes) {
   return value;
 }
 
+// "" when `value` of the first record is plausible, or what is wrong.
+std::string Implausible(double value, double low, double high,
+                        const char* name) {
+  if (std::isfinite(value) && value >= low && value <= high) return "";
+  std::ostringstream problem;
+  problem << "record 1's " << name << " is " << value << ", outside [" << low
+          << ", " << high << "]";
+  return problem.str();
+}
+
+// Whether the first record can be an SBET's (time in seconds of a week,
+// latitude and longitude, a height on Earth) or an smrmsg's
+// (time, non-negative RMS): random bytes fail it, so a file of another kind
+// is named as such before its size or a later record is.
+template <int kFields>
+std::string FirstRecordProblem(const std::array<double, kFields>& record) {
+  // Seconds of the week, unwrapped across a few weeks at most.
+  std::string problem = Implausible(record[0], 0.0, 1e7, "time");
+  if (kFields == 17) {
+    // Degrees where radians belong pass here: ReadSbet names that mistake.
+    if (problem.empty())
+      problem = Implausible(record[1], -360, 360, "latitude");
+    if (problem.empty()) {
+      problem = Implausible(record[2], -360, 360, "longitude");
+    }
+    if (problem.empty()) problem = Implausible(record[3], -1e4, 1e5, "height");
+  } else {
+    for (int f = 1; f < kFields && problem.empty(); ++f) {
+      problem = Implausible(record[f], 0.0, 1e6, "RMS");
+    }
+  }
+  return problem;
+}
+
 // Every record of a file of fixed-size records of doubles. Throws when the
-// size is not whole records (naming the truncated one) or a value is not
-// finite.
+// first record is not of this kind ("not <what>"), the size is not whole
+// records (naming the truncated one) or a value is not finite.
 template <int kFields>
 std::vector<std::array<double, kFields>> ReadRecords(const std::string& path,
                                                      const char* what) {
   constexpr int kBytes = kFields * 8;
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
-    throw InputError(path, 0, std::string("cannot open the ") + what);
+    throw InputError(path, 0,
+                     std::filesystem::exists(path, error)
+                         ? std::string("not ") + what +
+                               ": a device, pipe or folder, not a file of "
+                               "records"
+                         : std::string("cannot open ") + what);
   }
   const uintmax_t size = std::filesystem::file_size(path, error);
   std::ifstream in(path, std::ios::binary);
   if (error || !in) {
-    throw InputError(path, 0, std::string("cannot read the ") + what);
-  }
-  if (size % kBytes != 0) {
-    std::ostringstream problem;
-    problem << "record " << size / kBytes + 1 << " is truncated: the file has "
-            << size << " bytes, not a whole number of " << kBytes
-            << "-byte records (" << kFields << " doubles)";
-    throw InputError(path, 0, problem.str());
+    throw InputError(path, 0, std::string("cannot read ") + what);
   }
   std::vector<std::array<double, kFields>> records(size / kBytes);
   std::array<unsigned char, kBytes> buffer;
@@ -59,6 +91,25 @@ std::vector<std::array<double, kFields>> ReadRecords(const std::string& path,
     }
     for (int f = 0; f < kFields; ++f) {
       records[r][f] = LittleEndianDouble(buffer.data() + 8 * f);
+    }
+    if (r == 0) {
+      const std::string problem = FirstRecordProblem<kFields>(records[0]);
+      if (!problem.empty()) {
+        throw InputError(path, 0,
+                         std::string("not ") + what + " (" +
+                             std::to_string(kFields) +
+                             " little-endian doubles per record): " + problem);
+      }
+      if (size % kBytes != 0) {
+        std::ostringstream problem_text;
+        problem_text << "record " << size / kBytes + 1
+                     << " is truncated: the file has " << size
+                     << " bytes, not a whole number of " << kBytes
+                     << "-byte records (" << kFields << " doubles)";
+        throw InputError(path, 0, problem_text.str());
+      }
+    }
+    for (int f = 0; f < kFields; ++f) {
       if (!std::isfinite(records[r][f])) {
         std::ostringstream problem;
         problem << "record " << r + 1 << " (byte " << r * kBytes << "): field "
@@ -66,6 +117,12 @@ std::vector<std::array<double, kFields>> ReadRecords(const std::string& path,
         throw InputError(path, 0, problem.str());
       }
     }
+  }
+  if (size % kBytes != 0) {  // shorter than one record
+    std::ostringstream problem;
+    problem << "not " << what << ": " << size << " bytes, less than one "
+            << kBytes << "-byte record (" << kFields << " doubles)";
+    throw InputError(path, 0, problem.str());
   }
   return records;
 }
@@ -89,7 +146,7 @@ std::array<double, 10> AccuracyAt(
 void AddAccuracies(const std::string& smrmsg_path,
                    std::vector<TrajectorySample>* samples) {
   std::vector<std::array<double, 10>> rms =
-      ReadRecords<10>(smrmsg_path, "smrmsg accuracy file");
+      ReadRecords<10>(smrmsg_path, "an smrmsg accuracy file");
   if (rms.empty()) throw InputError(smrmsg_path, 0, "no record");
   std::vector<double> times;
   for (const auto& r : rms) times.push_back(r[0]);
@@ -132,7 +189,7 @@ void AddAccuracies(const std::string& smrmsg_path,
 std::vector<TrajectorySample> ReadSbet(const std::string& sbet_path,
                                        const std::string& smrmsg_path) {
   const std::vector<std::array<double, 17>> records =
-      ReadRecords<17>(sbet_path, "SBET file");
+      ReadRecords<17>(sbet_path, "an SBET file");
   std::vector<double> times;
   for (const auto& r : records) times.push_back(r[0]);
   UnwrapGpsWeekSeconds(&times);

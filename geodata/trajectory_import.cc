@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "geodata/gps_time.h"
+#include "geodata/text_input.h"
 #include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
@@ -189,10 +190,9 @@ std::vector<TrajectorySample> ReadTrajectoryCsv(
   if (!error.empty()) {
     throw std::invalid_argument("CsvTrajectoryFormat: " + error);
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot read the trajectory file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Capped, and binary data refused as it is read (/dev/zero never ends).
+  const std::string text =
+      ReadTextInput(path, "delimited trajectory file", kMaxTrajectoryTextBytes);
   std::vector<std::string> required;
   for (const std::string& name : RequiredNames()) {
     if (!format.crs.empty() && (name == "lat" || name == "lon")) continue;
@@ -208,7 +208,7 @@ std::vector<TrajectorySample> ReadTrajectoryCsv(
         std::make_unique<CrsTransformer>(Crs(format.crs), crs_options);
   }
   const CsvTable table = CsvTable::Parse(
-      AsCommaSeparated(text.str(), format.delimiter, path), path, required);
+      AsCommaSeparated(text, format.delimiter, path), path, required);
   bool has_accuracy = true;
   for (const std::string& name : AccuracyNames()) {
     has_accuracy = has_accuracy && table.HasColumn(FileColumn(format, name));

@@ -12,6 +12,7 @@
 #include "survey/crs.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
+#include "tools/file_arguments.h"
 
 namespace zebrageo {
 namespace {
@@ -70,6 +71,10 @@ void RunExportGcp(const ExportArguments& args) {
     const std::string projections =
         (path.parent_path() / (path.stem().string() + "_projections.csv"))
             .string();
+    if (std::filesystem::is_directory(projections)) {
+      throw UsageError(projections +
+                       " (the projections beside -o) is a folder");
+    }
     WriteMetashapeMarkers(gcps, coordinates.system, args.output, projections);
     LOG(INFO) << "wrote " << projections;
   } else {
@@ -102,7 +107,9 @@ void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--format", args->format, "odm, opensfm, metashape or gpkg")
       ->required()
       ->check(CLI::IsMember({"odm", "opensfm", "metashape", "gpkg"}));
-  sub->add_option("-o,--output", args->output, "file to write")->required();
+  sub->add_option("-o,--output", args->output, "file to write")
+      ->required()
+      ->check(OutputFileValidator());
   sub->add_option("--crs", args->crs,
                   "CRS of the coordinates (odm, metashape, gpkg): 'utm' (the "
                   "survey's WGS84 UTM zone, ODM's usual), an EPSG code or a "

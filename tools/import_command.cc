@@ -10,13 +10,16 @@
 #include <vector>
 
 #include "geodata/calibration_import.h"
+#include "geodata/camera_mount.h"
 #include "geodata/gps_time.h"
 #include "geodata/trajectory_import.h"
 #include "pipeline/exit_codes.h"
 #include "survey/crs.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 #include "survey/rig.h"
 #include "tools/commands.h"
+#include "tools/file_arguments.h"
 
 namespace zebrageo {
 namespace {
@@ -27,8 +30,7 @@ struct ImportArguments {
   std::string output;
   int width = 0;
   int height = 0;
-  std::vector<double> lever_arm_m = {0.0, 0.0, 0.0};
-  double pitch_down_deg = 0.0;
+  MountArguments mount;
   CalibrationImportOptions options;
 };
 
@@ -46,38 +48,37 @@ struct TrajectoryArguments {
   std::vector<std::string> grid_dirs;
 };
 
-// Mounting of the left camera on the vehicle: camera looking forward
-// (camera z = body x, camera x = body y, camera y = body z), pitched down
-// by `pitch_down_deg`, at `lever_arm_m` from the IMU origin.
-Eigen::Isometry3d ForwardLookingMount(const std::vector<double>& lever_arm_m,
-                                      double pitch_down_deg) {
-  Eigen::Matrix3d R_body_cam_level;
-  R_body_cam_level << 0, 0, 1, 1, 0, 0, 0, 1, 0;
-  // Pitching the camera down rotates it about the body's y (right) axis by
-  // a negative angle (FRD: positive pitch is nose up).
-  const double pitch = -pitch_down_deg * M_PI / 180.0;
-  const Eigen::Matrix3d R_pitch =
-      Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R_pitch * R_body_cam_level;
-  T.translation() =
-      Eigen::Vector3d(lever_arm_m[0], lever_arm_m[1], lever_arm_m[2]);
-  return T;
+// The mount options and -o of every calibration import.
+void AddRigOutputOptions(CLI::App* sub, ImportArguments* args) {
+  sub->add_option("-o,--output", args->output, "rig.yaml to write")
+      ->required()
+      ->check(OutputFileValidator());
+  AddMountOptions(sub, &args->mount);
 }
 
-// The mount options every calibration import shares.
-void AddMountOptions(CLI::App* sub, ImportArguments* args) {
-  sub->add_option("-o,--output", args->output, "rig.yaml to write")->required();
-  sub->add_option("--lever-arm", args->lever_arm_m,
-                  "left camera position in the body frame x y z (m)")
-      ->expected(3);
-  sub->add_option("--pitch-down-deg", args->pitch_down_deg,
-                  "downward pitch of the left camera (degrees)");
-}
-
-void WriteImportedRig(const Rig& rig, const std::string& output) {
+// Writes the rig and says how each camera sits on the vehicle, in the
+// mount convention the options take (so a user can check it against the
+// mount sheet).
+void WriteImportedRig(const Rig& rig, const CameraMount& mount,
+                      const std::string& output) {
+  if (!mount.rotation_stated) {
+    LOG(WARNING) << "no mount rotation given: the left camera is taken as "
+                    "looking straight ahead along the body x axis, level. "
+                    "State the mount's roll, pitch and yaw (or "
+                    "--mount-rotation): an unstated misalignment of half a "
+                    "degree gives wrong matches, and zebrageo does not "
+                    "estimate it";
+  }
   WriteRig(rig, output);
   LOG(INFO) << "wrote " << output << " (" << rig.cameras.size() << " cameras)";
+  for (const RigCamera& camera : rig.cameras) {
+    const Eigen::Vector3d angles = MountAngles(camera.T_body_cam.linear());
+    const Eigen::Vector3d t = camera.T_body_cam.translation();
+    LOG(INFO) << camera.camera.name() << ": lever arm " << t.x() << " " << t.y()
+              << " " << t.z() << " m, mount roll " << RadToDeg(angles.x())
+              << " pitch " << RadToDeg(angles.y()) << " yaw "
+              << RadToDeg(angles.z()) << " deg";
+  }
 }
 
 CsvTrajectoryFormat CsvFormatOf(const TrajectoryArguments& args) {
@@ -138,55 +139,53 @@ void AddImportCalibrationCommands(CLI::App* app,
     auto args = std::make_shared<ImportArguments>();
     CLI::App* sub = app->add_subcommand(
         "import-kalibr",
-        "Convert a Kalibr camchain.yaml (pinhole, radtan or equidistant) to "
-        "rig.yaml. cam0 is mounted looking forward, pitched down by "
-        "--pitch-down-deg, at --lever-arm (body FRD, metres); the others "
-        "follow from T_cn_cnm1.");
+        std::string("Convert a Kalibr camchain.yaml (pinhole, radtan or "
+                    "equidistant) to rig.yaml. cam0 is the left camera; the "
+                    "others follow from T_cn_cnm1. ") +
+            kMountHelp);
     sub->add_option("camchain", args->calibration, "Kalibr camchain.yaml")
         ->required()
         ->check(CLI::ExistingFile);
-    AddMountOptions(sub, args.get());
+    AddRigOutputOptions(sub, args.get());
     sub->add_option("--max-fit-error-px", args->options.max_fit_error_px,
                     "largest error of the OpenCV model fitted to an "
                     "equidistant one (pixels)")
         ->capture_default_str();
-    commands->push_back(
-        {sub, [args] {
-           WriteImportedRig(
-               ImportKalibrCamchain(
-                   args->calibration,
-                   ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg),
-                   args->options),
-               args->output);
-         }});
+    commands->push_back({sub, [args] {
+                           const CameraMount mount = MountOf(args->mount);
+                           WriteImportedRig(
+                               ImportKalibrCamchain(args->calibration,
+                                                    mount.T_body_cam(),
+                                                    args->options),
+                               mount, args->output);
+                         }});
   }
   {
     auto args = std::make_shared<ImportArguments>();
     CLI::App* sub = app->add_subcommand(
         "import-ros-camera-info",
-        "Convert a left and a right ROS camera_info YAML (from "
-        "camera_calibration's stereo calibration) to rig.yaml, the left "
-        "camera mounted as for import-opencv-stereo.");
+        std::string("Convert a left and a right ROS camera_info YAML (from "
+                    "camera_calibration's stereo calibration) to rig.yaml. ") +
+            kMountHelp);
     sub->add_option("left", args->calibration, "left camera_info YAML")
         ->required()
         ->check(CLI::ExistingFile);
     sub->add_option("right", args->right_calibration, "right camera_info YAML")
         ->required()
         ->check(CLI::ExistingFile);
-    AddMountOptions(sub, args.get());
+    AddRigOutputOptions(sub, args.get());
     sub->add_option("--max-fit-error-px", args->options.max_fit_error_px,
                     "largest error of the OpenCV model fitted to an "
                     "equidistant one (pixels)")
         ->capture_default_str();
-    commands->push_back(
-        {sub, [args] {
-           WriteImportedRig(
-               ImportRosCameraInfoPair(
-                   args->calibration, args->right_calibration,
-                   ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg),
-                   args->options),
-               args->output);
-         }});
+    commands->push_back({sub, [args] {
+                           const CameraMount mount = MountOf(args->mount);
+                           WriteImportedRig(
+                               ImportRosCameraInfoPair(
+                                   args->calibration, args->right_calibration,
+                                   mount.T_body_cam(), args->options),
+                               mount, args->output);
+                         }});
   }
 }
 
@@ -206,7 +205,8 @@ void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands) {
       ->required()
       ->check(CLI::IsMember({"sbet", "novatel", "csv"}));
   sub->add_option("-o,--output", args->output, "trajectory.csv to write")
-      ->required();
+      ->required()
+      ->check(OutputFileValidator());
   sub->add_option("--smrmsg", args->smrmsg,
                   "sbet: the smrmsg accuracy file (for the sd_* columns)")
       ->check(CLI::ExistingFile);
@@ -245,24 +245,25 @@ void AddImportOpenCvStereoCommand(CLI::App* app,
   auto args = std::make_shared<ImportArguments>();
   CLI::App* sub = app->add_subcommand(
       "import-opencv-stereo",
-      "Convert an OpenCV stereoCalibrate file (YAML/XML with K1, D1, K2, D2, "
-      "R, T) to rig.yaml. The left camera is mounted looking forward, "
-      "pitched down by --pitch-down-deg, at --lever-arm (body FRD, metres).");
+      std::string("Convert an OpenCV stereoCalibrate file (YAML/XML with K1, "
+                  "D1, K2, D2, R, T) to rig.yaml. ") +
+          kMountHelp);
   sub->add_option("calibration", args->calibration, "OpenCV FileStorage file")
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--width", args->width,
-                  "image width in pixels (if not in the file)");
+                  "image width in pixels (if not in the file)")
+      ->check(CLI::Range(1, 100000));
   sub->add_option("--height", args->height,
-                  "image height in pixels (if not in the file)");
-  AddMountOptions(sub, args.get());
+                  "image height in pixels (if not in the file)")
+      ->check(CLI::Range(1, 100000));
+  AddRigOutputOptions(sub, args.get());
   commands->push_back(
       {sub, [args] {
-         WriteImportedRig(
-             ImportOpenCvStereo(
-                 args->calibration, args->width, args->height,
-                 ForwardLookingMount(args->lever_arm_m, args->pitch_down_deg)),
-             args->output);
+         const CameraMount mount = MountOf(args->mount);
+         WriteImportedRig(ImportOpenCvStereo(args->calibration, args->width,
+                                             args->height, mount.T_body_cam()),
+                          mount, args->output);
        }});
 }
 

@@ -1,6 +1,7 @@
 // `zebrageo run SURVEY -o RESULTS` and `zebrageo report SURVEY -o RESULTS`.
 #include <glog/logging.h>
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -59,6 +60,28 @@ void Run(const RunArguments& args) {
             << "\n";
 }
 
+// `report` reads a results folder: one without a stage's output (a typo, a
+// run that never started) is refused, not reported as an empty run.
+void CheckHasStageOutputs(const std::string& results) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(results, error)) {
+    throw UsageError(results +
+                     " is not a results folder (run `zebrageo run "
+                     "SURVEY -o " +
+                     results + "` first)");
+  }
+  for (const char* file :
+       {kReconstructedBandsFile, kMatchesFile, kTrajectoryCorrectedFile}) {
+    if (fs::exists(fs::path(results) / file, error)) return;
+  }
+  throw UsageError(results + " holds no stage output (" +
+                   kReconstructedBandsFile + ", " + kMatchesFile + ", " +
+                   kTrajectoryCorrectedFile +
+                   "): nothing to report; run `zebrageo run SURVEY -o " +
+                   results + "` first");
+}
+
 }  // namespace
 
 void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
@@ -91,6 +114,7 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
       "Write report.json and report.html from an existing results folder.",
       report_args.get());
   commands->push_back({report, [report_args] {
+                         CheckHasStageOutputs(report_args->results);
                          ResultsSession session(
                              report_args->results,
                              ResultsSession::OnError::kRemoveContractOutputs);

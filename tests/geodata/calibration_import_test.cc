@@ -168,9 +168,14 @@ TEST(CalibrationImport, EquidistantKalibrCameraProjectsLikeOpenCvFisheye) {
        << ", " << cx << ", " << cy << "]\n  distortion_model: equidistant\n"
        << "  distortion_coeffs: [" << k[0] << ", " << k[1] << ", " << k[2]
        << ", " << k[3] << "]\n  resolution: [1280, 960]\n";
+  // A stereo camchain: cam1 the same lens 0.8 m to the right.
+  std::string cam1 = text.str().substr(5);
+  text << "cam1:\n  T_cn_cnm1:\n  - [1, 0, 0, -0.8]\n  - [0, 1, 0, 0]\n"
+       << "  - [0, 0, 1, 0]\n  - [0, 0, 0, 1]\n"
+       << cam1;
   const Rig rig = ImportKalibrCamchain(tmp.Write("camchain.yaml", text.str()),
                                        Eigen::Isometry3d::Identity(), {});
-  ASSERT_EQ(rig.cameras.size(), 1u);
+  ASSERT_EQ(rig.cameras.size(), 2u);
   const Camera& camera = rig.cameras[0].camera;
   std::vector<cv::Point3d> rays;
   for (double x = -0.45; x <= 0.45; x += 0.02) {
