@@ -2,6 +2,7 @@
 # Installs the Debian packages zebrageo needs, when they are missing.
 # Safe to run repeatedly: it only calls apt-get when something is absent.
 set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
 
 PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git clang libclang-rt-14-dev
@@ -16,7 +17,25 @@ PACKAGES=(
   postgresql postgresql-client postgresql-15-postgis-3
   python3 python3-numpy python3-opencv python3-yaml
   chromium
+  libcpp-httplib-dev libsqlite3-dev libarchive-dev python3-prometheus-client
 )
+
+# The npm tools of the server's tests (tests/server/js: an OpenAPI validator,
+# puppeteer-core driving Debian's Chromium), exactly as package-lock.json
+# pins them. Node.js and npm come with the machine; without them the tests
+# that need them skip.
+install_npm_tools() {
+  local js="$here/tests/server/js"
+  if ! command -v npm >/dev/null 2>&1 || [ ! -f "$js/package-lock.json" ]; then
+    return 0
+  fi
+  if [ -f "$js/node_modules/.package-lock.json" ] &&
+    [ "$js/node_modules/.package-lock.json" -nt "$js/package-lock.json" ]; then
+    return 0
+  fi
+  echo "setup: npm ci in tests/server/js" >&2
+  (cd "$js" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+}
 
 missing=()
 for package in "${PACKAGES[@]}"; do
@@ -26,6 +45,7 @@ for package in "${PACKAGES[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
+  install_npm_tools
   exit 0
 fi
 
@@ -40,4 +60,5 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+install_npm_tools
 echo "setup: done" >&2

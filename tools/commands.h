@@ -61,6 +61,8 @@ void AddImportCalibrationCommands(CLI::App* app,
 void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands);
 // export-gcp (tools/export_command.cc).
 void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands);
+// serve (tools/serve_command.cc).
+void AddServeCommand(CLI::App* app, std::vector<Command>* commands);
 
 }  // namespace zebrageo
 

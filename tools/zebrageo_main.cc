@@ -62,6 +62,7 @@ int Main(int argc, char** argv) {
   AddImportCalibrationCommands(&app, &commands);
   AddImportTrajectoryCommand(&app, &commands);
   AddExportGcpCommand(&app, &commands);
+  AddServeCommand(&app, &commands);
 
   try {
     app.parse(argc, argv);
