@@ -206,7 +206,8 @@ void GetPage(const ApiContext& context, const httplib::Request& req,
              httplib::Response& res) {
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
-       << "<title>zebrageo serve</title><style>" << kStyle
+       << "<title>zebrageo serve</title>"
+       << "<link rel='icon' href='data:,'><style>" << kStyle
        << "</style></head>\n<body>\n<h1>zebrageo serve <small>"
        << ZEBRAGEO_VERSION_STRING << ", " << context.options.workers
        << " workers</small></h1>\n";
@@ -229,7 +230,8 @@ void GetPage(const ApiContext& context, const httplib::Request& req,
           "<a href='/metrics'>metrics</a></p>\n"
        << "<script src='/app.js'></script>\n</body></html>\n";
   res.set_header("Content-Security-Policy",
-                 "default-src 'self'; style-src 'self' 'unsafe-inline'; "
+                 "default-src 'self'; img-src 'self' data:; "
+                 "style-src 'self' 'unsafe-inline'; "
                  "frame-ancestors 'none'");
   res.set_header("X-Content-Type-Options", "nosniff");
   res.set_content(html.str(), "text/html; charset=utf-8");
