@@ -20,8 +20,7 @@ class ServerApi : public ::testing::Test {
   static void SetUpTestSuite() {
     folder_ = new TemporaryFolder();
     survey_ = folder_->Path("root/surveys/a");
-    fs::create_directories(folder_->Path("root/surveys"));
-    SimulateAndRunCli(survey_, "", 1, folder_->Path("a"));
+    CopySurvey(CachedSmallSurvey(1, false), survey_);
     tar_ = folder_->Path("a.tar.gz");
     WriteTestArchive(tar_, "tar", SurveyEntries(survey_, "./a/"));
     zip_ = folder_->Path("a.zip");
@@ -29,19 +28,9 @@ class ServerApi : public ::testing::Test {
   }
   static void TearDownTestSuite() { delete folder_; }
 
-  // The CLI's results on the survey, run on first use (the cases that
-  // need none run alone under ASan, where a run is slow).
-  static const std::string& Reference() {
-    if (reference_.empty()) {
-      const std::string folder = folder_->Path("reference");
-      const int status = RunZebrageo(
-          "--log-level error run " + Quote(survey_) + " -o " + Quote(folder),
-          folder_->Path("ref.out"), folder_->Path("ref.err"));
-      EXPECT_EQ(status, 0) << ReadWholeFile(folder_->Path("ref.err"));
-      reference_ = folder;
-    }
-    return reference_;
-  }
+  // The CLI's results on the survey (the cases that need none run alone
+  // under ASan, where a run is slow).
+  static std::string Reference() { return CachedSmallSurvey(1, true); }
 
   // A server on the shared data root.
   std::unique_ptr<ServerProcess> StartServer(int workers) {
@@ -52,12 +41,11 @@ class ServerApi : public ::testing::Test {
   }
 
   static TemporaryFolder* folder_;
-  static std::string survey_, reference_, tar_, zip_;
+  static std::string survey_, tar_, zip_;
 };
 
 TemporaryFolder* ServerApi::folder_ = nullptr;
-std::string ServerApi::survey_, ServerApi::reference_, ServerApi::tar_,
-    ServerApi::zip_;
+std::string ServerApi::survey_, ServerApi::tar_, ServerApi::zip_;
 
 // A receiver of webhooks that refuses the first delivery (the server must
 // retry) and records the rest.

@@ -40,9 +40,11 @@ class ServerFaults : public ::testing::Test {
     fs::create_directories(folder_->Path("root/surveys"));
     for (int seed = 1; seed <= 3; ++seed) {
       const std::string name = "s" + std::to_string(seed);
-      SimulateAndRunCli(folder_->Path("root/surveys/" + name),
-                        folder_->Path("reference/" + name), seed,
-                        folder_->Path(name));
+      CopySurvey(CachedSmallSurvey(seed, false),
+                 folder_->Path("root/surveys/" + name));
+      fs::create_directories(folder_->Path("reference"));
+      fs::create_directory_symlink(CachedSmallSurvey(seed, true),
+                                   folder_->Path("reference/" + name));
     }
   }
   static void TearDownTestSuite() { delete folder_; }

@@ -18,8 +18,7 @@ class ServerSecurity : public ::testing::Test {
   static void SetUpTestSuite() {
     folder_ = new TemporaryFolder();
     survey_ = folder_->Path("root/surveys/a");
-    fs::create_directories(folder_->Path("root/surveys"));
-    SimulateAndRunCli(survey_, "", 1, folder_->Path("a"));
+    CopySurvey(CachedSmallSurvey(1, false), survey_);
     server_ = new ServerProcess(folder_->Path("root"), 1);
     ASSERT_TRUE(server_->Start()) << server_->output();
   }

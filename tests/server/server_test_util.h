@@ -13,6 +13,7 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/socket.h>
 #include <sys/sysmacros.h>
 #include <sys/wait.h>
@@ -335,25 +336,70 @@ inline void ExpectResultsEqualCli(httplib::Client& client,
   }
 }
 
-// Simulates the small survey of cli_util.h with `seed` into `folder`, and
-// runs the CLI on it into `reference`.
-inline void SimulateAndRunCli(const std::string& folder,
-                              const std::string& reference, int seed,
-                              const std::string& scratch) {
-  std::string arguments = SmallSurveyArguments();
-  arguments = std::regex_replace(arguments, std::regex("--seed 1"),
-                                 "--seed " + std::to_string(seed));
-  ASSERT_EQ(RunZebrageo("--log-level error simulate " + arguments + " -o " +
-                            Quote(folder),
-                        scratch + ".sim.out", scratch + ".sim.err"),
-            0)
-      << ReadWholeFile(scratch + ".sim.err");
-  if (reference.empty()) return;
-  ASSERT_EQ(RunZebrageo("--log-level error run " + Quote(folder) + " -o " +
-                            Quote(reference),
-                        scratch + ".run.out", scratch + ".run.err"),
-            0)
-      << ReadWholeFile(scratch + ".run.err");
+// The small survey of cli_util.h simulated with `seed`, and (`reference`)
+// the CLI's results on it, made once for all the server's tests: ctest
+// runs each case in a process of its own. Cached in the build tree
+// (build/test-cache/zebrageo-server-<binary stamp>/), under a lock so that
+// parallel tests wait for the first; older builds' caches are removed.
+inline std::string CachedSmallSurvey(int seed, bool reference) {
+  namespace fs = std::filesystem;
+  const fs::path cache =
+      fs::path(ZEBRAGEO_BINARY).parent_path().parent_path() / "test-cache";
+  fs::create_directories(cache);
+  const auto size = fs::file_size(ZEBRAGEO_BINARY);
+  const auto time = fs::last_write_time(ZEBRAGEO_BINARY);
+  const std::string prefix = "zebrageo-server-";
+  const fs::path folder =
+      cache / (prefix + std::to_string(size) + "-" +
+               std::to_string(time.time_since_epoch().count()));
+  const fs::path survey = folder / ("s" + std::to_string(seed));
+  const fs::path results = folder / ("s" + std::to_string(seed) + "-cli");
+  const fs::path wanted = reference ? results : survey;
+  const int lock = ::open((cache / "zebrageo-server.lock").c_str(),
+                          O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+  EXPECT_GE(lock, 0);
+  EXPECT_EQ(::flock(lock, LOCK_EX), 0);
+  if (!fs::exists(folder)) {
+    for (const auto& entry : fs::directory_iterator(cache)) {
+      if (entry.path().filename().string().rfind(prefix, 0) == 0) {
+        fs::remove_all(entry.path());
+      }
+    }
+    fs::create_directories(folder);
+  }
+  const std::string log = (folder / "log").string();
+  if (!fs::exists(survey.string() + ".complete")) {
+    std::string arguments =
+        std::regex_replace(SmallSurveyArguments(), std::regex("--seed 1"),
+                           "--seed " + std::to_string(seed));
+    fs::remove_all(survey);
+    EXPECT_EQ(RunZebrageo("--log-level error simulate " + arguments + " -o " +
+                              Quote(survey.string()),
+                          log + ".out", log),
+              0)
+        << ReadWholeFile(log);
+    std::ofstream(survey.string() + ".complete") << "ok\n";
+  }
+  if (reference && !fs::exists(results.string() + ".complete")) {
+    fs::remove_all(results);
+    EXPECT_EQ(RunZebrageo("--log-level error run " + Quote(survey.string()) +
+                              " -o " + Quote(results.string()),
+                          log + ".out", log),
+              0)
+        << ReadWholeFile(log);
+    std::ofstream(results.string() + ".complete") << "ok\n";
+  }
+  ::close(lock);
+  return wanted.string();
+}
+
+// A copy of a cached survey at `to` (its files hard links: no job writes
+// in a survey).
+inline void CopySurvey(const std::string& from, const std::string& to) {
+  std::filesystem::create_directories(std::filesystem::path(to).parent_path());
+  std::filesystem::copy(from, to,
+                        std::filesystem::copy_options::recursive |
+                            std::filesystem::copy_options::create_hard_links);
 }
 
 }  // namespace zebrageo
