@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "survey/atomic_file.h"
@@ -71,7 +72,29 @@ RunProgress ReadRunProgress(const JobFiles& files) {
     ++complete;
   }
   if (complete == static_cast<int>(kStages.size())) progress.stage = "report";
-  progress.fraction = complete / (kStages.size() + 1.0);
+  double within = 0.0;
+  // Within a stage: the run's last progress line in the log, "I... ] step:
+  // done/total (NN%), S s" (tools/progress.cc, every 10 % when stderr is
+  // not a terminal). The lines of the stage's own name advance the
+  // fraction (the largest: a stage never goes back); the last line names
+  // the step (the tie points inside adjust).
+  static const std::regex kLine(
+      R"(\] ([A-Za-z][A-Za-z ]*): ([0-9]+)/([0-9]+) \([0-9]+%\))");
+  const std::string tail = LogTail(files.Log(), 40, 1 << 16);
+  for (std::sregex_iterator it(tail.begin(), tail.end(), kLine), end; it != end;
+       ++it) {
+    progress.step = (*it)[1].str();
+    const double done = std::stod((*it)[2].str());
+    const double total = std::stod((*it)[3].str());
+    if (progress.step == progress.stage && total > 0) {
+      within = std::max(within, std::clamp(done / total, 0.0, 1.0));
+    }
+  }
+  if (progress.step.empty() ||
+      tail.find(progress.step + ": done in") != std::string::npos) {
+    progress.step.clear();
+  }
+  progress.fraction = (complete + within) / (kStages.size() + 1.0);
   return progress;
 }
 

@@ -1,8 +1,11 @@
 #include "server/server.h"
 
+#include <fcntl.h>
 #include <glog/logging.h>
 #include <limits.h>
 #include <stdlib.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -113,6 +116,28 @@ std::string ReadToken(const std::string& path) {
   return token;
 }
 
+// One server per data root: two would run the same jobs twice. The lock
+// (flock, released by the kernel even when the server is killed) is held
+// for the life of the process; the file holds the holder's pid.
+void LockDataRoot(const std::string& root) {
+  const std::string path = root + "/zebrageo-serve.lock";
+  const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw UsageError("--data-root " + root + ": cannot be written");
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    std::ifstream in(path);
+    std::string pid;
+    std::getline(in, pid);
+    close(fd);
+    throw UsageError("--data-root " + root +
+                     ": another zebrageo serve uses it (pid " + pid + ")");
+  }
+  const std::string pid = std::to_string(getpid()) + "\n";
+  if (ftruncate(fd, 0) != 0 || write(fd, pid.data(), pid.size()) < 0) {
+    LOG(WARNING) << path << ": cannot record the pid";
+  }
+  // Deliberately left open: the lock lasts as long as the process.
+}
+
 }  // namespace
 
 std::string ServerOptions::Check() const {
@@ -203,6 +228,7 @@ Server::Impl::Impl(const ServerOptions& options) {
   context.root = resolved;
   if (!options.token_file.empty())
     context.token = ReadToken(options.token_file);
+  LockDataRoot(context.root);
   fs::create_directories(context.root + "/jobs");
   store = std::make_unique<JobStore>(context.root + "/zebrageo-jobs.sqlite");
   RunnerOptions runner_options;

@@ -98,6 +98,14 @@ TEST_F(ServerFaults,
 
   ServerProcess second(root, 3);
   ASSERT_TRUE(second.Start()) << second.output();
+  // One server per data root.
+  const std::string twice = folder_->Path("twice.err");
+  EXPECT_EQ(RunZebrageo("serve --port 0 --data-root " + Quote(root),
+                        folder_->Path("twice.out"), twice),
+            2);
+  EXPECT_NE(ReadWholeFile(twice).find("another zebrageo serve uses it"),
+            std::string::npos)
+      << ReadWholeFile(twice);
   httplib::Client again = ClientFor(second.port());
   for (int j = 0; j < 4; ++j) {
     const auto& [id, survey] = jobs[j];

@@ -12,6 +12,7 @@
 #include "server/confined_path.h"
 #include "server/job_store.h"
 #include "server/metrics.h"
+#include "server/run_invocation.h"
 #include "server/server.h"
 #include "tests/server/server_test_util.h"
 
@@ -157,6 +158,41 @@ TEST(Metrics, RendersThePrometheusTextFormat) {
       std::string::npos);
   EXPECT_NE(text.find("zebrageo_seconds_sum{stage=\"match\"} 5.5\n"),
             std::string::npos);
+}
+
+// What the server reads of a run: its stage and progress from
+// run_state.json and the log's progress lines, its error from the log.
+TEST(RunInvocation, ProgressAndErrorAreReadFromTheRunsFiles) {
+  TemporaryFolder folder;
+  const JobFiles files{folder.Path()};
+  EXPECT_EQ(ReadRunProgress(files).fraction, 0.0);
+  folder.Write("results/run_state.json",
+               R"({"stages": {"reconstruct": {"complete": true},
+                              "match": {"complete": false}}})");
+  folder.Write(
+      "log.txt",
+      "I1207 01:00:00.0 1 progress.cc:43] reconstruct: 4/20 (20%), 1 s\n"
+      "I1207 01:00:01.0 1 progress.cc:57] reconstruct: done in 2 s\n"
+      "I1207 01:00:02.0 1 progress.cc:43] match: 10/20 (50%), 0.1 s\n"
+      "I1207 01:00:03.0 1 progress.cc:43] match: 5/20 (20%), 0.1 s\n");
+  RunProgress progress = ReadRunProgress(files);
+  EXPECT_EQ(progress.stage, "match");
+  EXPECT_EQ(progress.step, "match");
+  EXPECT_DOUBLE_EQ(progress.fraction, (1 + 0.5) / 4.0);  // never back
+  folder.Write("results/run_state.json",
+               R"({"stages": {"reconstruct": {"complete": true},
+                   "match": {"complete": true}, "adjust": {"complete": true}}})");
+  progress = ReadRunProgress(files);
+  EXPECT_EQ(progress.stage, "report");
+  EXPECT_DOUBLE_EQ(progress.fraction, 0.75);
+
+  folder.Write("log.txt",
+               "zebrageo serve: attempt 1\nzebrageo: error: first\nline\n"
+               "zebrageo: error: rig.yaml, line 1: not YAML\nlast\n");
+  EXPECT_EQ(RunErrorFromLog(files.Log()), "rig.yaml, line 1: not YAML");
+  EXPECT_EQ(LogTail(files.Log(), 2),
+            "zebrageo: error: rig.yaml, line 1: not YAML\nlast\n");
+  EXPECT_EQ(LogTail(files.Log(), 100).substr(0, 9), "zebrageo ");
 }
 
 // Every route the server has is in server/openapi.json, and every path
