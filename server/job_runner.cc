@@ -101,6 +101,7 @@ JobFiles JobRunner::FilesOf(const std::string& id) const {
 
 void JobRunner::Start() {
   RecoverJobsOfDeadServer();
+  RemoveOrphanFolders();
   for (const Job& job : store_->PendingWebhooks()) {
     webhooks_->Send(job.id, job.webhook);
   }
@@ -140,6 +141,20 @@ void JobRunner::RecoverJobsOfDeadServer() {
                   "the server stopped during this run; resumed on restart");
     }
     store_->Update(job);
+  }
+}
+
+void JobRunner::RemoveOrphanFolders() {
+  // A folder without a job: an upload the server was extracting when it
+  // died (a job is stored only once its survey is complete).
+  const std::string jobs = options_.data_root + "/jobs";
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(jobs, error)) {
+    const std::string id = entry.path().filename().string();
+    if (!store_->Get(id)) {
+      LOG(INFO) << "removing " << entry.path().string() << ": no such job";
+      fs::remove_all(entry.path(), error);
+    }
   }
 }
 

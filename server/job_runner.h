@@ -87,6 +87,7 @@ class JobRunner {
   void RunJob(Job job);
   void FinishJob(const std::string& id, pid_t pid, int exit_code, int signal);
   void RecoverJobsOfDeadServer();
+  void RemoveOrphanFolders();
   Job WithLiveProgress(Job job) const;  // under mutex_
   // A job has ended: stores it, counts it, sends its webhook (under mutex_).
   void Ended(Job* job);

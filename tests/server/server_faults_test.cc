@@ -96,8 +96,14 @@ TEST_F(ServerFaults,
   }
   EXPECT_EQ(interrupted, 3) << "a job ended before the kill";
 
+  // An upload the killed server was extracting: a folder without a job.
+  const std::string orphan = root + "/jobs/00000000000000aa";
+  fs::create_directories(orphan + "/survey");
+  std::ofstream(orphan + "/upload") << "half an archive";
+
   ServerProcess second(root, 3);
   ASSERT_TRUE(second.Start()) << second.output();
+  EXPECT_FALSE(fs::exists(orphan));
   // One server per data root.
   const std::string twice = folder_->Path("twice.err");
   EXPECT_EQ(RunZebrageo("serve --port 0 --data-root " + Quote(root),
