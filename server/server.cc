@@ -373,7 +373,7 @@ Server::Server(const ServerOptions& options)
 
 Server::~Server() { Stop(); }
 
-int Server::Bind() {
+int Server::Start() {
   const ServerOptions& options = impl_->context.options;
   if (options.port == 0) {
     impl_->port = impl_->http.bind_to_any_port(options.host);
@@ -386,13 +386,11 @@ int Server::Bind() {
     throw std::runtime_error("cannot listen on " + options.host + ":" +
                              std::to_string(options.port));
   }
+  impl_->runner->Start();
   return impl_->port;
 }
 
-void Server::Serve() {
-  impl_->runner->Start();
-  impl_->http.listen_after_bind();
-}
+void Server::Serve() { impl_->http.listen_after_bind(); }
 
 void Server::Stop() {
   if (!impl_) return;

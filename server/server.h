@@ -56,10 +56,12 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds; returns the port (the chosen one for port 0). Throws
-  // std::runtime_error when the address cannot be bound.
-  int Bind();
-  // Starts the workers and serves until Stop(). Call Bind() first.
+  // Binds, then recovers the jobs of a previous server and starts the
+  // workers; returns the port (the chosen one for port 0). Requests wait
+  // until Serve(). Throws std::runtime_error when the address cannot be
+  // bound.
+  int Start();
+  // Serves requests until Stop(). Call Start() first.
   void Serve();
   // From any thread (a signal handler's thread): stops serving and the
   // workers; running jobs stay running in the store and resume next time.

@@ -34,7 +34,7 @@ void Serve(const ServeArguments& args) {
   signal(SIGPIPE, SIG_IGN);
 
   Server server(options);
-  const int port = server.Bind();
+  const int port = server.Start();
   std::thread stopper([&server, stop_signals] {
     int received = 0;
     sigwait(&stop_signals, &received);
