@@ -157,8 +157,12 @@ std::string ServerOptions::Check() const {
   if (http_threads < 1 || http_threads > 1024) {
     return "--http-threads: 1 to 1024";
   }
-  if (cancel_grace_s < 0) return "--cancel-grace: must be >= 0";
-  if (job_memory_limit_mb < 0) return "--job-memory-limit: must be >= 0";
+  if (!(cancel_grace_s >= 0)) return "--cancel-grace: must be >= 0";
+  if (job_memory_limit_mb < 0) return "--job-memory-limit-mb: must be >= 0";
+  if (webhook_attempts < 1) return "--webhook-attempts: must be >= 1";
+  if (!(webhook_first_delay_s >= 0)) {
+    return "--webhook-retry-delay: must be >= 0";
+  }
   return "";
 }
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <thread>
 
+#include "pipeline/exit_codes.h"
 #include "server/server.h"
 #include "tools/commands.h"
 
@@ -21,6 +22,11 @@ struct ServeArguments {
 
 void Serve(const ServeArguments& args) {
   ServerOptions options = args.options;
+  for (const double mb : {args.max_upload_mb, args.max_extracted_mb}) {
+    if (!(mb > 0 && mb < 1e9)) {
+      throw UsageError("--max-upload-mb and --max-extracted-mb: from 0 to 1e9");
+    }
+  }
   options.max_upload_bytes = static_cast<int64_t>(args.max_upload_mb * 1048576);
   options.max_extracted_bytes =
       static_cast<int64_t>(args.max_extracted_mb * 1048576);
