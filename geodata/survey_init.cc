@@ -50,7 +50,7 @@ class Rollback {
 };
 
 // `path` relative to `folder` when it lies inside it (symbolic links
-// resolved), else "".
+// resolved; "." for the folder itself), else "".
 std::string InsideRelative(const fs::path& path, const fs::path& folder) {
   std::error_code error;
   const fs::path p = fs::weakly_canonical(path, error);
@@ -100,8 +100,10 @@ SurveyInitSummary InitSurvey(
   rollback.CreateFolders(survey);
   // Images: named where they are when inside the survey, else linked in.
   summary.images_prefix = InsideRelative(inputs.images_folder, survey);
+  const bool inside = !summary.images_prefix.empty();
+  if (summary.images_prefix == ".") summary.images_prefix.clear();
   ExposureTable table = summary.listing.table;
-  if (summary.images_prefix.empty()) {
+  if (!inside) {
     summary.images_prefix = "images";
     for (const ExposureImage& image : table.images) {
       const fs::path to = survey / "images" / image.image;
@@ -111,8 +113,10 @@ SurveyInitSummary InitSurvey(
       ++summary.images_linked;
     }
   }
-  for (ExposureImage& image : table.images) {
-    image.image = summary.images_prefix + "/" + image.image;
+  if (!summary.images_prefix.empty()) {
+    for (ExposureImage& image : table.images) {
+      image.image = summary.images_prefix + "/" + image.image;
+    }
   }
 
   SurveyManifest manifest = inputs.manifest;

@@ -294,6 +294,52 @@ TEST_F(InitCommand, JpegSbetAndKalibrGiveTheSurveyAndItsScore) {
   EXPECT_NEAR(h_after[1], h_after[0], 0.01);
 }
 
+// Images already inside the survey folder, one subfolder per camera, named
+// by their UTC stamp in nanoseconds (as ROS writes them), the right camera
+// 100 us after the left: paired by time, named in place, not linked.
+TEST_F(InitCommand, ImagesInsideTheSurveyNamedByUtcNanosecondsArePairedByTime) {
+  const std::string survey = tmp_->Path("inside");
+  for (const ExposureImage& image : exposures_->images) {
+    const bool right = rig_->cameras[image.camera].camera.name() == "right";
+    const double unix_time = kGpsEpochUnix + kGpsWeek * 604800.0 + image.time -
+                             kGpsMinusUtc2024 + (right ? 100e-6 : 0.0);
+    char name[64];
+    std::snprintf(
+        name, sizeof(name), "%lld.png",
+        static_cast<long long>(std::llround(unix_time * 1e6)) * 1000LL);
+    const fs::path to = fs::path(survey) / "cams" /
+                        rig_->cameras[image.camera].camera.name() / name;
+    fs::create_directories(to.parent_path());
+    fs::create_hard_link(survey_ + "/" + image.image, to);
+  }
+  ASSERT_EQ(
+      RunZebrageo("init " + Quote(survey) + " --images " +
+                      Quote(survey + "/cams") + " --trajectory " +
+                      Quote(survey_ + "/trajectory.csv") + " --calibration " +
+                      Quote(survey_ + "/rig.yaml") + " --roadmarks " +
+                      Quote(survey_ + "/roadmarks.geojson") +
+                      " --exposure-times filename --time-unit ns "
+                      "--time-clock unix",
+                  tmp_->Path("out"), tmp_->Path("err")),
+      0)
+      << ReadWholeFile(tmp_->Path("err"));
+  const std::string summary = ReadWholeFile(tmp_->Path("out"));
+  EXPECT_NE(summary.find("paired by times (0 without a partner"),
+            std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("images under cams/\n"), std::string::npos) << summary;
+  EXPECT_FALSE(fs::exists(survey + "/images"));
+  const Rig rig = ReadRig(survey + "/rig.yaml", "rig.yaml");
+  const ExposureTable table =
+      ReadExposures(survey + "/exposures.csv", "exposures.csv", rig);
+  ASSERT_EQ(table.exposures.size(), exposures_->exposures.size());
+  for (size_t e = 0; e < table.exposures.size(); ++e) {
+    // The mean of the left and the right stamp: 50 us late.
+    EXPECT_NEAR(table.exposures[e].time, exposures_->exposures[e].time + 50e-6,
+                2e-6);
+  }
+}
+
 TEST_F(InitCommand, GpsTimeTakenForUtcIsNamedAndNothingIsLeft) {
   const std::string survey = tmp_->Path("gps-clock");
   EXPECT_EQ(RunZebrageo(InitArguments(survey) + " --exif-clock gps",
