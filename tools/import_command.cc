@@ -163,10 +163,10 @@ void AddImportCalibrationCommands(CLI::App* app,
     auto args = std::make_shared<ImportArguments>();
     CLI::App* sub = app->add_subcommand(
         "import-kalibr",
-        std::string("Convert a Kalibr camchain.yaml (pinhole, radtan or "
-                    "equidistant) to rig.yaml. cam0 is the left camera; the "
-                    "others follow from T_cn_cnm1. ") +
-            kMountHelp);
+        "Convert a Kalibr camchain.yaml (pinhole, radtan or equidistant) to "
+        "rig.yaml, with the left camera's mount (see --help). cam0 is the "
+        "left camera; the others follow from T_cn_cnm1.");
+    sub->footer(kMountHelp);
     sub->add_option("camchain", args->calibration, "Kalibr camchain.yaml")
         ->required()
         ->check(CLI::ExistingFile);
@@ -188,9 +188,10 @@ void AddImportCalibrationCommands(CLI::App* app,
     auto args = std::make_shared<ImportArguments>();
     CLI::App* sub = app->add_subcommand(
         "import-ros-camera-info",
-        std::string("Convert a left and a right ROS camera_info YAML (from "
-                    "camera_calibration's stereo calibration) to rig.yaml. ") +
-            kMountHelp);
+        "Convert a left and a right ROS camera_info YAML (from "
+        "camera_calibration's stereo calibration) to rig.yaml, with the left "
+        "camera's mount (see --help).");
+    sub->footer(kMountHelp);
     sub->add_option("left", args->calibration, "left camera_info YAML")
         ->required()
         ->check(CLI::ExistingFile);
@@ -242,9 +243,9 @@ void AddImportOpenCvStereoCommand(CLI::App* app,
   auto args = std::make_shared<ImportArguments>();
   CLI::App* sub = app->add_subcommand(
       "import-opencv-stereo",
-      std::string("Convert an OpenCV stereoCalibrate file (YAML/XML with K1, "
-                  "D1, K2, D2, R, T) to rig.yaml. ") +
-          kMountHelp);
+      "Convert an OpenCV stereoCalibrate file (YAML/XML with K1, D1, K2, D2, "
+      "R, T) to rig.yaml, with the left camera's mount (see --help).");
+  sub->footer(kMountHelp);
   sub->add_option("calibration", args->calibration, "OpenCV FileStorage file")
       ->required()
       ->check(CLI::ExistingFile);

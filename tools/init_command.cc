@@ -199,16 +199,17 @@ void AddInitCommand(CLI::App* app, std::vector<Command>* commands) {
   args->trajectory.prefix = "trajectory-";
   CLI::App* sub = app->add_subcommand(
       "init",
+      "Create a survey folder (survey.yaml, rig.yaml, trajectory.csv, "
+      "exposures.csv) from a folder of images, a GNSS/INS trajectory, a "
+      "stereo calibration and a road-mark database, then check it.");
+  sub->footer(
       std::string(
-          "Create a survey folder (survey.yaml, rig.yaml, trajectory.csv, "
-          "exposures.csv) from a folder of images, a GNSS/INS trajectory, a "
-          "stereo calibration and a road-mark database, then check it. "
           "Images (PNG, TIFF, JPEG) are in one subfolder per camera of the "
           "rig (left/, right/) or picked by --camera-pattern; outside the "
           "survey they are hard-linked into SURVEY/images. Times are put on "
           "the trajectory's clock (GPS seconds of week): UTC times (EXIF, "
           "--time-clock unix) get GPS - UTC from the leap seconds. ") +
-          kMountHelp);
+      kMountHelp);
   sub->add_option("survey", args->survey, "survey folder to create")
       ->required();
   sub->add_option("--images", args->images, "folder of the images")
