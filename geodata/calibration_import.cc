@@ -435,4 +435,29 @@ Rig ImportRosCameraInfoPair(const std::string& left_path,
   return rig;
 }
 
+CalibrationFormat DetectCalibrationFormat(const std::string& path) {
+  const std::string text = ReadText(path, "calibration file");
+  if (text.rfind("%YAML:1.0", 0) == 0 || text.rfind("%YAML 1.0", 0) == 0 ||
+      text.find("<opencv_storage>") != std::string::npos) {
+    return CalibrationFormat::kOpenCv;
+  }
+  YAML::Node root;
+  try {
+    root = ParseYamlDocument(text, path);
+  } catch (const InputError&) {
+    root = YAML::Node();
+  }
+  if (root.IsMap()) {
+    if (root["cam0"]) return CalibrationFormat::kKalibr;
+    if (root["image_width"] && root["camera_matrix"]) {
+      return CalibrationFormat::kRos;
+    }
+    if (root["cameras"]) return CalibrationFormat::kRig;
+  }
+  throw InputError(path, 0,
+                   "not a calibration file zebrageo reads: an OpenCV "
+                   "stereoCalibrate file, a Kalibr camchain, ROS "
+                   "camera_info files or a rig.yaml");
+}
+
 }  // namespace zebrageo

@@ -56,6 +56,15 @@ Rig ImportRosCameraInfoPair(const std::string& left_path,
                             const Eigen::Isometry3d& T_body_left,
                             const CalibrationImportOptions& options);
 
+// The calibration formats zebrageo init reads.
+enum class CalibrationFormat { kOpenCv, kKalibr, kRos, kRig };
+
+// The format of a calibration file from its content: an OpenCV FileStorage
+// ("%YAML:1.0" or <opencv_storage>), a Kalibr camchain (cam0), a ROS
+// camera_info (image_width, camera_matrix) or a zebrageo rig.yaml
+// (cameras). Throws InputError naming the file when it is none of them.
+CalibrationFormat DetectCalibrationFormat(const std::string& path);
+
 // OpenCV distortion fitted to an equidistant camera over its image.
 struct EquidistantFit {
   std::array<double, 5> distortion{};  // k1, k2, 0, 0, k3

@@ -270,4 +270,15 @@ std::vector<TrajectorySample> ReadTrajectoryCsv(
   return samples;
 }
 
+std::string GuessTrajectoryFormat(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "cannot read the trajectory file");
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), head.size());
+  head.resize(static_cast<size_t>(in.gcount()));
+  if (head.find('\0') != std::string::npos) return "sbet";
+  if (head.find("#INSPVA") != std::string::npos) return "novatel";
+  return "csv";
+}
+
 }  // namespace zebrageo

@@ -113,6 +113,11 @@ std::vector<TrajectorySample> ReadTrajectoryCsv(
 void CheckImportedSamples(const std::vector<TrajectorySample>& samples,
                           const std::string& path, const std::string& unit);
 
+// "sbet", "novatel" or "csv" from the first 64 KiB of `path`: binary data
+// (a NUL byte) is an SBET, "#INSPVA" a NovAtel log, other text a delimited
+// export. Throws InputError when it cannot be read.
+std::string GuessTrajectoryFormat(const std::string& path);
+
 // Normalises angles as the contract writes them: heading [0, 2pi), roll
 // (-pi, pi], pitch [-pi/2, pi/2].
 Attitude NormalizedAttitude(const Attitude& attitude);

@@ -9,7 +9,7 @@ PACKAGES=(
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
   libopencv-dev libopencv-contrib-dev libgeographiclib-dev
   libyaml-cpp-dev nlohmann-json3-dev libsimdjson-dev libcli11-dev libbz2-dev
-  libpng-dev libtiff-dev
+  libpng-dev libtiff-dev libjpeg-dev libexif-dev
   zlib1g-dev tzdata libgdal-dev gdal-bin
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev

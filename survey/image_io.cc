@@ -5,6 +5,9 @@
 
 #include <csetjmp>
 #include <cstdio>
+// jpeglib.h needs FILE and size_t declared before it.
+#include <jpeglib.h>
+
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -95,6 +98,106 @@ ImageHeader TiffHeader(const std::string& path,
   return header;
 }
 
+// libjpeg reports errors through error_exit, which must not return: it
+// longjmps back here. As for libpng, only trivially destructible locals live
+// between setjmp and the libjpeg calls. Returns false on a corrupt header.
+struct JpegErrorManager {
+  jpeg_error_mgr base;
+  std::jmp_buf jump;
+};
+
+bool ReadJpegSize(FILE* file, JDIMENSION* width, JDIMENSION* height) {
+  jpeg_decompress_struct info;
+  JpegErrorManager error;
+  info.err = jpeg_std_error(&error.base);
+  error.base.error_exit = [](j_common_ptr common) {
+    std::longjmp(reinterpret_cast<JpegErrorManager*>(common->err)->jump, 1);
+  };
+  error.base.output_message = [](j_common_ptr) {};  // the InputError says it
+  if (setjmp(error.jump)) {
+    jpeg_destroy_decompress(&info);
+    return false;
+  }
+  jpeg_create_decompress(&info);
+  // Markers before the frame header are not kept (EXIF, ICC profiles):
+  // libjpeg skips them without allocating.
+  jpeg_stdio_src(&info, file);
+  jpeg_read_header(&info, TRUE);  // up to the frame header: no pixel
+  *width = info.image_width;
+  *height = info.image_height;
+  jpeg_destroy_decompress(&info);
+  return true;
+}
+
+// Decodes a JPEG of `width` x `height` as 8-bit luminance (libjpeg's
+// grayscale output: the Y of YCbCr, BT.601 as cv::cvtColor's) into
+// `pixels` (width * height bytes). Returns false on an error or a warning:
+// libjpeg only warns on truncated or corrupt data and fills the rest with
+// grey, which must not pass for an image. Only trivially destructible
+// locals between setjmp and longjmp.
+bool DecodeJpegGray(FILE* file, int width, int height, unsigned char* pixels) {
+  jpeg_decompress_struct info;
+  JpegErrorManager error;
+  info.err = jpeg_std_error(&error.base);
+  error.base.error_exit = [](j_common_ptr common) {
+    std::longjmp(reinterpret_cast<JpegErrorManager*>(common->err)->jump, 1);
+  };
+  error.base.output_message = [](j_common_ptr) {};
+  if (setjmp(error.jump)) {
+    jpeg_destroy_decompress(&info);
+    return false;
+  }
+  jpeg_create_decompress(&info);
+  jpeg_stdio_src(&info, file);
+  jpeg_read_header(&info, TRUE);
+  info.out_color_space = JCS_GRAYSCALE;
+  jpeg_start_decompress(&info);
+  if (static_cast<int>(info.output_width) != width ||
+      static_cast<int>(info.output_height) != height ||
+      info.output_components != 1) {
+    jpeg_destroy_decompress(&info);
+    return false;
+  }
+  while (info.output_scanline < info.output_height) {
+    JSAMPROW row = pixels + static_cast<size_t>(info.output_scanline) * width;
+    if (jpeg_read_scanlines(&info, &row, 1) != 1) break;
+  }
+  const bool complete = info.output_scanline == info.output_height;
+  if (complete) jpeg_finish_decompress(&info);
+  const bool clean = complete && error.base.num_warnings == 0;
+  jpeg_destroy_decompress(&info);
+  return clean;
+}
+
+ImageHeader JpegHeader(const std::string& path,
+                       const std::string& display_name) {
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                             &std::fclose);
+  if (!file) throw InputError(display_name, 0, "cannot open image file");
+  JDIMENSION width = 0, height = 0;
+  if (!ReadJpegSize(file.get(), &width, &height) || width == 0 || height == 0) {
+    throw InputError(display_name, 0,
+                     "cannot decode image: corrupt JPEG header");
+  }
+  ImageHeader header;
+  header.format = ImageHeader::Format::kJpeg;
+  header.width = static_cast<int>(width);
+  header.height = static_cast<int>(height);
+  return header;
+}
+
+const char* FormatName(ImageHeader::Format format) {
+  switch (format) {
+    case ImageHeader::Format::kPng:
+      return "PNG";
+    case ImageHeader::Format::kTiff:
+      return "TIFF";
+    case ImageHeader::Format::kJpeg:
+      return "JPEG";
+  }
+  return "image";
+}
+
 std::string SizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
@@ -120,8 +223,12 @@ ImageHeader ReadImageHeader(const std::string& path,
       StartsWith(magic, size, "MM\0+", 4)) {
     return TiffHeader(path, display_name);
   }
+  // JPEG: a start-of-image marker, then any marker.
+  if (StartsWith(magic, size, "\xff\xd8\xff", 3)) {
+    return JpegHeader(path, display_name);
+  }
   throw InputError(display_name, 0,
-                   "cannot decode image (not a PNG or TIFF file)");
+                   "cannot decode image (not a PNG, TIFF or JPEG file)");
 }
 
 cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
@@ -149,6 +256,20 @@ cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
                          SizeText(expected_width, expected_height) +
                          " (from its header; not decoded)");
   }
+  if (header.format == ImageHeader::Format::kJpeg) {
+    cv::Mat pixels(header.height, header.width, CV_8UC1);
+    std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                               &std::fclose);
+    if (!file ||
+        !DecodeJpegGray(file.get(), header.width, header.height, pixels.data)) {
+      throw InputError(display_name, 0,
+                       "cannot decode image (corrupt or truncated JPEG data, "
+                       "or a CMYK JPEG)");
+    }
+    cv::Mat gray;
+    pixels.convertTo(gray, CV_32F);
+    return gray;
+  }
   cv::Mat raw;
   try {
     // ANYDEPTH keeps 16-bit images 16-bit (the default would cut them to 8).
@@ -157,12 +278,9 @@ cv::Mat ReadGrayImage(const std::string& path, const std::string& display_name,
     raw.release();  // some decoders throw on corrupt data instead of failing
   }
   if (raw.empty()) {
-    throw InputError(
-        display_name, 0,
-        "cannot decode image (corrupt or truncated " +
-            std::string(header.format == ImageHeader::Format::kPng ? "PNG"
-                                                                   : "TIFF") +
-            " data)");
+    throw InputError(display_name, 0,
+                     "cannot decode image (corrupt or truncated " +
+                         std::string(FormatName(header.format)) + " data)");
   }
   double scale = 1.0;
   switch (raw.depth()) {

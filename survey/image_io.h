@@ -1,6 +1,9 @@
-// Reading survey images: 8-bit grey or colour, 16-bit grey, PNG or TIFF.
+// Reading survey images: 8-bit grey or colour, 16-bit grey, PNG or TIFF;
+// 8-bit grey or colour JPEG (baseline or progressive, as mobile-mapping
+// cameras deliver them).
 //
-// An image's header is read first (libpng, libtiff: no pixel is decoded),
+// An image's header is read first (libpng, libtiff, libjpeg: no pixel is
+// decoded),
 // and an image larger than kMaxImagePixels or than its camera is refused
 // before the decoder allocates anything: a 400 KB PNG can claim 20000x20000
 // pixels, 400 MB to decode and 1.6 GB as floats.
@@ -19,15 +22,15 @@ namespace zebrageo {
 inline constexpr int64_t kMaxImagePixels = 64'000'000;
 
 struct ImageHeader {
-  enum class Format { kPng, kTiff };
+  enum class Format { kPng, kTiff, kJpeg };
   Format format = Format::kPng;
   int width = 0;
   int height = 0;
   int64_t pixels() const { return static_cast<int64_t>(width) * height; }
 };
 
-// Reads the header of a PNG or TIFF file without decoding its pixels.
-// Throws InputError naming `display_name`: unreadable, not PNG or TIFF
+// Reads the header of a PNG, TIFF or JPEG file without decoding its pixels.
+// Throws InputError naming `display_name`: unreadable, not PNG, TIFF or JPEG
 // ("cannot decode image ..."), or a corrupt header.
 ImageHeader ReadImageHeader(const std::string& path,
                             const std::string& display_name);

@@ -46,7 +46,8 @@ CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
 void AddAllowOutsidePathsFlag(CLI::App* subcommand, bool* allow);
 // How a stage command loads its survey.
 SurveyLoadOptions LoadOptionsOf(const StageArguments& args);
-// --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_rad, in degrees here).
+// --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_rad, in
+// degrees here).
 void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg);
 // A runner for a stage that is not built yet: it validates the survey (so
 // the user learns whether it is readable), then throws NotImplementedError.
@@ -59,6 +60,10 @@ void AddImportOpenCvStereoCommand(CLI::App* app,
 void AddImportCalibrationCommands(CLI::App* app,
                                   std::vector<Command>* commands);
 void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands);
+// init (tools/init_command.cc).
+void AddInitCommand(CLI::App* app, std::vector<Command>* commands);
+// What `check` prints about a loaded survey (tools/check_command.cc).
+void PrintSurveySummary(const Survey& survey);
 // export-gcp (tools/export_command.cc).
 void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands);
 // serve (tools/serve_command.cc).

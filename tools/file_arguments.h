@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geodata/camera_mount.h"
+#include "survey/trajectory.h"
 
 namespace zebrageo {
 
@@ -43,6 +44,31 @@ void AddMountOptions(CLI::App* sub, MountArguments* args);
 // The mount the arguments state. Throws UsageError (a rotation matrix that
 // is not one) or InputError (the mount file).
 CameraMount MountOf(const MountArguments& args);
+
+// The trajectory import's arguments (import-trajectory, init).
+struct TrajectoryArguments {
+  // Prefix of the format options' names: "" for import-trajectory
+  // (--format, --columns...), "trajectory-" for init.
+  std::string prefix;
+  std::string input;
+  std::string format = "auto";
+  std::string smrmsg;
+  std::string output;
+  std::string columns;
+  std::string angles = "deg";
+  std::string time = "week-seconds";
+  std::string delimiter = "comma";
+  std::string leap_seconds = "/usr/share/zoneinfo/leap-seconds.list";
+  std::string crs;
+  std::vector<std::string> grid_dirs;
+};
+
+// Adds --smrmsg, --[prefix]columns, angles, time, delimiter, crs,
+// --leap-seconds and --grid-dir (tools/import_command.cc).
+void AddTrajectoryFormatOptions(CLI::App* sub, TrajectoryArguments* args);
+// The samples the arguments name, on GPS seconds of week. Throws
+// InputError or UsageError.
+std::vector<TrajectorySample> ImportTrajectory(const TrajectoryArguments& args);
 
 // What the help of each import says about the mount.
 extern const char kMountHelp[];

@@ -34,20 +34,6 @@ struct ImportArguments {
   CalibrationImportOptions options;
 };
 
-struct TrajectoryArguments {
-  std::string input;
-  std::string format;
-  std::string smrmsg;
-  std::string output;
-  std::string columns;
-  std::string angles = "deg";
-  std::string time = "week-seconds";
-  std::string delimiter = "comma";
-  std::string leap_seconds = kDefaultLeapSecondsFile;
-  std::string crs;
-  std::vector<std::string> grid_dirs;
-};
-
 // The mount options and -o of every calibration import.
 void AddRigOutputOptions(CLI::App* sub, ImportArguments* args) {
   sub->add_option("-o,--output", args->output, "rig.yaml to write")
@@ -96,35 +82,15 @@ CsvTrajectoryFormat CsvFormatOf(const TrajectoryArguments& args) {
   format.grid_dirs = args.grid_dirs;
   if (!args.columns.empty()) {
     const std::string error = ParseColumnMap(args.columns, &format);
-    if (!error.empty()) throw UsageError("--columns: " + error);
+    if (!error.empty()) throw UsageError(args.prefix + "columns: " + error);
   }
   const std::string problem = format.Check();
-  if (!problem.empty()) throw UsageError("import-trajectory: " + problem);
+  if (!problem.empty()) throw UsageError(problem);
   return format;
 }
 
-std::vector<TrajectorySample> ReadTrajectory(const TrajectoryArguments& args) {
-  if (args.format == "sbet") return ReadSbet(args.input, args.smrmsg);
-  if (!args.smrmsg.empty()) {
-    throw UsageError("--smrmsg goes with --format sbet only");
-  }
-  return args.format == "novatel"
-             ? ReadNovatelAscii(args.input)
-             : ReadTrajectoryCsv(args.input, CsvFormatOf(args));
-}
-
 void RunImportTrajectory(const TrajectoryArguments& args) {
-  if (!args.crs.empty() && args.format != "csv") {
-    throw UsageError(
-        "--crs goes with --format csv only (SBET and NovAtel "
-        "logs are WGS84)");
-  }
-  std::vector<TrajectorySample> samples;
-  try {
-    samples = ReadTrajectory(args);
-  } catch (const CrsError& error) {
-    throw UsageError(std::string("--crs: ") + error.what());
-  }
+  const std::vector<TrajectorySample> samples = ImportTrajectory(args);
   WriteTrajectorySamples(samples, args.output);
   LOG(INFO) << "wrote " << args.output << " (" << samples.size()
             << " samples, GPS seconds of week " << samples.front().time
@@ -133,16 +99,74 @@ void RunImportTrajectory(const TrajectoryArguments& args) {
 
 }  // namespace
 
+std::vector<TrajectorySample> ImportTrajectory(
+    const TrajectoryArguments& args) {
+  std::string format = args.format;
+  if (format == "auto") {
+    format = GuessTrajectoryFormat(args.input);
+    LOG(INFO) << args.input << ": read as " << format;
+  }
+  if (!args.crs.empty() && format != "csv") {
+    throw UsageError("--" + args.prefix + "crs goes with --" + args.prefix +
+                     "format csv only (SBET and NovAtel logs are WGS84)");
+  }
+  if (format != "sbet" && !args.smrmsg.empty()) {
+    throw UsageError("--smrmsg goes with an SBET only");
+  }
+  try {
+    if (format == "sbet") return ReadSbet(args.input, args.smrmsg);
+    return format == "novatel"
+               ? ReadNovatelAscii(args.input)
+               : ReadTrajectoryCsv(args.input, CsvFormatOf(args));
+  } catch (const CrsError& error) {
+    throw UsageError("--" + args.prefix + "crs: " + error.what());
+  }
+}
+
+void AddTrajectoryFormatOptions(CLI::App* sub, TrajectoryArguments* args) {
+  const std::string p = "--" + args->prefix;
+  sub->add_option("--smrmsg", args->smrmsg,
+                  "sbet: the smrmsg accuracy file (for the sd_* columns)")
+      ->check(CLI::ExistingFile);
+  sub->add_option(p + "columns", args->columns,
+                  "csv: NAME=COLUMN,... for time, lat, lon, h, roll, pitch, "
+                  "heading, sd_e, sd_n, sd_u, sd_roll, sd_pitch, sd_heading "
+                  "(unmapped names are looked up as themselves)");
+  sub->add_option(p + "angles", args->angles,
+                  "csv: unit of lat, lon and the attitude: deg or rad")
+      ->check(CLI::IsMember({"deg", "rad"}))
+      ->capture_default_str();
+  sub->add_option(p + "time", args->time,
+                  "csv: week-seconds (GPS), gps-seconds (since 1980-01-06) "
+                  "or utc (ISO 8601, converted with leap seconds)")
+      ->check(CLI::IsMember({"week-seconds", "gps-seconds", "utc"}))
+      ->capture_default_str();
+  sub->add_option(p + "delimiter", args->delimiter,
+                  "csv: comma, whitespace or semicolon")
+      ->check(CLI::IsMember({"comma", "whitespace", "semicolon"}))
+      ->capture_default_str();
+  sub->add_option("--leap-seconds", args->leap_seconds,
+                  "IERS leap-seconds.list (UTC times)")
+      ->capture_default_str();
+  sub->add_option(p + "crs", args->crs,
+                  "csv: CRS of the positions (EPSG code, compound code with a "
+                  "geoid, PROJ string): columns x, y, h instead of lat, lon, "
+                  "h, transformed to WGS84 by PROJ");
+  sub->add_option("--grid-dir", args->grid_dirs,
+                  "csv --crs: a folder holding PROJ grids (geoid models), "
+                  "searched first");
+}
+
 void AddImportCalibrationCommands(CLI::App* app,
                                   std::vector<Command>* commands) {
   {
     auto args = std::make_shared<ImportArguments>();
     CLI::App* sub = app->add_subcommand(
         "import-kalibr",
-        std::string("Convert a Kalibr camchain.yaml (pinhole, radtan or "
-                    "equidistant) to rig.yaml. cam0 is the left camera; the "
-                    "others follow from T_cn_cnm1. ") +
-            kMountHelp);
+        "Convert a Kalibr camchain.yaml (pinhole, radtan or equidistant) to "
+        "rig.yaml, with the left camera's mount (see --help). cam0 is the "
+        "left camera; the others follow from T_cn_cnm1.");
+    sub->footer(kMountHelp);
     sub->add_option("camchain", args->calibration, "Kalibr camchain.yaml")
         ->required()
         ->check(CLI::ExistingFile);
@@ -164,9 +188,10 @@ void AddImportCalibrationCommands(CLI::App* app,
     auto args = std::make_shared<ImportArguments>();
     CLI::App* sub = app->add_subcommand(
         "import-ros-camera-info",
-        std::string("Convert a left and a right ROS camera_info YAML (from "
-                    "camera_calibration's stereo calibration) to rig.yaml. ") +
-            kMountHelp);
+        "Convert a left and a right ROS camera_info YAML (from "
+        "camera_calibration's stereo calibration) to rig.yaml, with the left "
+        "camera's mount (see --help).");
+    sub->footer(kMountHelp);
     sub->add_option("left", args->calibration, "left camera_info YAML")
         ->required()
         ->check(CLI::ExistingFile);
@@ -201,42 +226,15 @@ void AddImportTrajectoryCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("input", args->input, "trajectory file")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("--format", args->format, "sbet, novatel or csv")
+  sub->add_option("--format", args->format,
+                  "sbet, novatel, csv, or auto (binary: sbet; #INSPVA "
+                  "records: novatel; else csv)")
       ->required()
-      ->check(CLI::IsMember({"sbet", "novatel", "csv"}));
+      ->check(CLI::IsMember({"sbet", "novatel", "csv", "auto"}));
   sub->add_option("-o,--output", args->output, "trajectory.csv to write")
       ->required()
       ->check(OutputFileValidator());
-  sub->add_option("--smrmsg", args->smrmsg,
-                  "sbet: the smrmsg accuracy file (for the sd_* columns)")
-      ->check(CLI::ExistingFile);
-  sub->add_option("--columns", args->columns,
-                  "csv: NAME=COLUMN,... for time, lat, lon, h, roll, pitch, "
-                  "heading, sd_e, sd_n, sd_u, sd_roll, sd_pitch, sd_heading "
-                  "(unmapped names are looked up as themselves)");
-  sub->add_option("--angles", args->angles,
-                  "csv: unit of lat, lon and the attitude: deg or rad")
-      ->check(CLI::IsMember({"deg", "rad"}))
-      ->capture_default_str();
-  sub->add_option("--time", args->time,
-                  "csv: week-seconds (GPS), gps-seconds (since 1980-01-06) "
-                  "or utc (ISO 8601, converted with leap seconds)")
-      ->check(CLI::IsMember({"week-seconds", "gps-seconds", "utc"}))
-      ->capture_default_str();
-  sub->add_option("--delimiter", args->delimiter,
-                  "csv: comma, whitespace or semicolon")
-      ->check(CLI::IsMember({"comma", "whitespace", "semicolon"}))
-      ->capture_default_str();
-  sub->add_option("--leap-seconds", args->leap_seconds,
-                  "csv --time utc: IERS leap-seconds.list")
-      ->capture_default_str();
-  sub->add_option("--crs", args->crs,
-                  "csv: CRS of the positions (EPSG code, compound code with a "
-                  "geoid, PROJ string): columns x, y, h instead of lat, lon, "
-                  "h, transformed to WGS84 by PROJ");
-  sub->add_option("--grid-dir", args->grid_dirs,
-                  "csv --crs: a folder holding PROJ grids (geoid models), "
-                  "searched first");
+  AddTrajectoryFormatOptions(sub, args.get());
   commands->push_back({sub, [args] { RunImportTrajectory(*args); }});
 }
 
@@ -245,9 +243,9 @@ void AddImportOpenCvStereoCommand(CLI::App* app,
   auto args = std::make_shared<ImportArguments>();
   CLI::App* sub = app->add_subcommand(
       "import-opencv-stereo",
-      std::string("Convert an OpenCV stereoCalibrate file (YAML/XML with K1, "
-                  "D1, K2, D2, R, T) to rig.yaml. ") +
-          kMountHelp);
+      "Convert an OpenCV stereoCalibrate file (YAML/XML with K1, D1, K2, D2, "
+      "R, T) to rig.yaml, with the left camera's mount (see --help).");
+  sub->footer(kMountHelp);
   sub->add_option("calibration", args->calibration, "OpenCV FileStorage file")
       ->required()
       ->check(CLI::ExistingFile);

@@ -61,6 +61,7 @@ int Main(int argc, char** argv) {
   AddImportOpenCvStereoCommand(&app, &commands);
   AddImportCalibrationCommands(&app, &commands);
   AddImportTrajectoryCommand(&app, &commands);
+  AddInitCommand(&app, &commands);
   AddExportGcpCommand(&app, &commands);
   AddServeCommand(&app, &commands);
 

@@ -113,7 +113,7 @@ TEST(ReadGrayImage, RejectsGarbageBytes) {
                         "header"));
   const std::string text = folder.Write("text.png", "hello, world\n");
   EXPECT_THAT(ErrorOfRead(text),
-              HasSubstr("cannot decode image (not a PNG or TIFF file)"));
+              HasSubstr("cannot decode image (not a PNG, TIFF or JPEG file)"));
   // A valid header and nothing after it.
   const std::string truncated =
       folder.Write("truncated.png", PngHeaderClaiming(64, 48));
@@ -168,6 +168,61 @@ TEST(ReadGrayImage, RejectsAnImageOfTheWrongSize) {
               HasSubstr("images/x.png: image is 64x48 pixels but the rig's "
                         "camera is 1920x1080"));
   EXPECT_EQ(ReadGrayImage(path, "small.png", 64, 48).at<float>(0, 0), 7.0f);
+}
+
+// A small JPEG whose frame header (SOF) claims `width` x `height`: the
+// header reader sees that size; the pixel data are the small image's.
+std::string JpegClaiming(int width, int height) {
+  std::vector<uchar> bytes;
+  EXPECT_TRUE(cv::imencode(".jpg",
+                           cv::Mat(48, 64, CV_8UC3, cv::Scalar(1, 2, 3)), bytes,
+                           {cv::IMWRITE_JPEG_QUALITY, 95}));
+  std::string jpeg(bytes.begin(), bytes.end());
+  const size_t sof = jpeg.find("\xff\xc0");
+  EXPECT_NE(sof, std::string::npos);
+  jpeg[sof + 5] = static_cast<char>(height >> 8);
+  jpeg[sof + 6] = static_cast<char>(height & 0xff);
+  jpeg[sof + 7] = static_cast<char>(width >> 8);
+  jpeg[sof + 8] = static_cast<char>(width & 0xff);
+  return jpeg;
+}
+
+TEST(ReadGrayImage, ReadsJpegThroughTheSameHeaderFirstLimits) {
+  TemporaryFolder folder;
+  const cv::Mat colour(48, 64, CV_8UC3, cv::Scalar(40, 120, 200));
+  ASSERT_TRUE(cv::imwrite(folder.Path("a.jpg"), colour,
+                          {cv::IMWRITE_JPEG_QUALITY, 100}));
+  const ImageHeader header = ReadImageHeader(folder.Path("a.jpg"), "a.jpg");
+  EXPECT_EQ(header.format, ImageHeader::Format::kJpeg);
+  EXPECT_EQ(header.width, 64);
+  EXPECT_EQ(header.height, 48);
+  // Luminance of BGR (40, 120, 200): 0.299 R + 0.587 G + 0.114 B = 134.8.
+  const cv::Mat gray = ReadGrayImage(folder.Path("a.jpg"), "a.jpg", 64, 48);
+  EXPECT_NEAR(gray.at<float>(24, 32), 134.8, 2.0);
+  // 60000 x 60000 claimed: refused from the header, never decoded.
+  const std::string big = folder.Write("big.jpg", JpegClaiming(60000, 60000));
+  EXPECT_THAT(ErrorOfRead(big),
+              HasSubstr("image is 60000x60000 pixels, more than the limit of "
+                        "64 megapixels (from its header; not decoded)"));
+  EXPECT_THAT(
+      ErrorOfRead(folder.Write("wide.jpg", JpegClaiming(1280, 960)), 640, 480),
+      HasSubstr("image is 1280x960 pixels but the rig's camera is "
+                "640x480 (from its header; not decoded)"));
+  // A start-of-image marker and garbage.
+  EXPECT_THAT(ErrorOfRead(folder.Write("bad.jpg",
+                                       std::string("\xff\xd8\xff\x01xx", 6))),
+              HasSubstr("cannot decode image: corrupt JPEG header"));
+  // The header and half of the data: libjpeg would fill the rest with grey
+  // and only warn; that is refused.
+  cv::Mat noise(480, 640, CV_8UC1);
+  cv::randu(noise, 0, 255);
+  std::vector<uchar> bytes;
+  ASSERT_TRUE(cv::imencode(".jpg", noise, bytes));
+  const std::string whole(bytes.begin(), bytes.end());
+  EXPECT_THAT(
+      ErrorOfRead(folder.Write("cut.jpg", whole.substr(0, whole.size() / 2))),
+      HasSubstr("cannot decode image (corrupt or truncated JPEG "
+                "data"));
 }
 
 }  // namespace
