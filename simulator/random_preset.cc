@@ -60,6 +60,20 @@ void DrawPlace(std::mt19937_64* rng, SimulationOptions* o) {
                              : Uniform(rng, 0.0, 360.0);
 }
 
+// `crossings` on the street (as many as its length holds), at least the
+// longest crossing's length + 6 m apart.
+void SetCrossingCount(int crossings, SimulationOptions* o) {
+  const double longest_crossing =
+      o->max_band_length_m + o->road_width_m * std::tan(30.0 * kPi / 180.0);
+  const double min_spacing = longest_crossing + 6.0;
+  // The road holds positions * spacing + 22 m (Check()).
+  const int most = static_cast<int>((o->road_length_m - 22.0) / min_spacing);
+  crossings = std::max(1, std::min(crossings, most));
+  o->num_crossings = crossings;
+  o->min_crossing_spacing_m = std::max(
+      min_spacing, std::min(40.0, (o->road_length_m - 22.0) / crossings - 1.0));
+}
+
 void DrawStreet(std::mt19937_64* rng, const RandomPresetLimits& limits,
                 SimulationOptions* o) {
   const double max_length =
@@ -88,10 +102,7 @@ void DrawStreet(std::mt19937_64* rng, const RandomPresetLimits& limits,
   o->occluding_vehicle_probability = Uniform(rng, 0.0, 0.5);
   // Crossings: a short street has 2; a longer one one every 35-100 m up to
   // 400 m (city blocks), every 50-250 m beyond.
-  const double longest_crossing =
-      o->max_band_length_m + o->road_width_m * std::tan(30.0 * kPi / 180.0);
-  const double min_spacing = longest_crossing + 6.0;
-  int crossings =
+  const int crossings =
       short_street
           ? 2
           : std::clamp(
@@ -101,12 +112,7 @@ void DrawStreet(std::mt19937_64* rng, const RandomPresetLimits& limits,
                                             : Uniform(rng, 50.0, 250.0)))),
                 2, 14);
   o->num_stale_crossings = 0;
-  // The road holds positions * spacing + 22 m (Check()).
-  const int most = static_cast<int>((o->road_length_m - 22.0) / min_spacing);
-  crossings = std::max(1, std::min(crossings, most));
-  o->num_crossings = crossings;
-  o->min_crossing_spacing_m = std::max(
-      min_spacing, std::min(40.0, (o->road_length_m - 22.0) / crossings - 1.0));
+  SetCrossingCount(crossings, o);
 }
 
 void DrawVehicleAndRig(std::mt19937_64* rng, SimulationOptions* o) {
@@ -137,7 +143,50 @@ void DrawVehicleAndRig(std::mt19937_64* rng, SimulationOptions* o) {
   o->k3 = Uniform(rng, -0.02, 0.0);
 }
 
+// A GNSS outage as the field has them (issue 43): 10-60 s in which the
+// INS error grows to 1-5 m (velocity and acceleration bias, heading drift
+// times the distance), a step of up to about 5 m when GNSS returns (the
+// outage's drift taken out, and the GNSS's own error, 0-3 m, decaying over
+// 10-120 s), the claimed sd growing through it half the time, crossings
+// inside it and none for 150 m after it. The street is lengthened (within
+// the limits) to hold 40 m before the outage, the outage and the 150 m,
+// with a crossing every 60-130 m; the outage shortened where it cannot.
+// Drawn from its own generator: the other knobs' draws do not change.
+void DrawFieldOutage(uint64_t seed, const RandomPresetLimits& limits,
+                     SimulationOptions* o) {
+  std::mt19937_64 rng(sim::SubSeed(seed, kRandomPresetSeed, 2));
+  o->outage_ins_drift = true;
+  o->outage_duration_s = Uniform(&rng, 10.0, 60.0);
+  o->outage_drift_m = Uniform(&rng, 1.0, 5.0);
+  o->outage_heading_drift_deg = LogUniform(&rng, 0.01, 0.2);
+  o->gnss_return_jump_m =
+      Uniform(&rng, 0.0, std::max(0.3, std::min(3.0, 5.0 - o->outage_drift_m)));
+  o->gnss_return_decay_s = Uniform(&rng, 10.0, 120.0);
+  o->outage_sd_growth_m =
+      Bernoulli(&rng, 0.5) ? 0.0 : Uniform(&rng, 0.3, 1.0) * o->outage_drift_m;
+  o->outage_clear_after_m = 150.0;
+  constexpr double kLeadM = 40.0;
+  const double max_length =
+      std::max(limits.min_road_length_m, limits.max_road_length_m);
+  const double needed = kLeadM + o->outage_duration_s * o->vehicle_speed_mps +
+                        o->outage_clear_after_m + 20.0;
+  const double spacing = Uniform(&rng, 60.0, 130.0);
+  if (o->road_length_m < needed) {
+    o->road_length_m = std::min(needed, max_length);
+    SetCrossingCount(
+        std::clamp(static_cast<int>(std::lround(o->road_length_m / spacing)), 2,
+                   14),
+        o);
+  }
+  const double room =
+      o->road_length_m - kLeadM - o->outage_clear_after_m - 20.0;
+  o->outage_duration_s =
+      std::clamp(room / o->vehicle_speed_mps, 10.0, o->outage_duration_s);
+  o->outage_start_s = 2.0;  // PlaceOutage moves it
+}
+
 void DrawTrajectoryError(std::mt19937_64* rng, const std::string& kind,
+                         const RandomPresetLimits& limits,
                          SimulationOptions* o) {
   o->drift_along_track_m = Uniform(rng, 0.05, 1.5);
   o->drift_cross_track_m = Uniform(rng, 0.05, 1.5);
@@ -156,6 +205,9 @@ void DrawTrajectoryError(std::mt19937_64* rng, const std::string& kind,
     o->outage_drift_m = Uniform(rng, 0.3, 3.0);
     o->gnss_return_jump_m = Uniform(rng, 0.0, 0.5);
   }
+  // The outage kind's outages are the field's (drawn apart: the other
+  // draws stay); a mixed survey keeps the quadratic one.
+  if (kind == "outage") DrawFieldOutage(o->seed, limits, o);
   // Multipath: the cross-track error switching by about a metre within
   // 10-40 m of travel, about once per 150 m.
   const bool multipath =
@@ -249,7 +301,7 @@ std::string DrawRandomOptions(uint64_t seed, const RandomPresetLimits& limits,
   DrawPlace(&rng, &o);
   DrawStreet(&rng, limits, &o);
   DrawVehicleAndRig(&rng, &o);
-  DrawTrajectoryError(&rng, o.scenario, &o);
+  DrawTrajectoryError(&rng, o.scenario, limits, &o);
   DrawDatabase(&rng, o.scenario, &o);
   // Extra crossings only in the database go on the road too.
   const double longest_crossing =
@@ -303,6 +355,11 @@ std::string RandomOptionsBrief(const SimulationOptions& o) {
   if (o.outage_duration_s > 0.0) {
     out.precision(0);
     out << ", outage " << o.outage_duration_s << " s";
+    if (o.outage_ins_drift) {
+      out.precision(1);
+      out << " INS " << o.outage_drift_m << " m, GNSS " << o.gnss_return_jump_m
+          << " m" << (o.outage_sd_growth_m > 0.0 ? ", sd grows" : ", sd flat");
+    }
   }
   if (o.num_multipath_switches > 0) {
     out.precision(1);

@@ -226,8 +226,31 @@ struct SimulationOptions {
   double outage_duration_s = 0.0;
   double outage_drift_m = 1.0;
   // Extra step of the error when GNSS returns (random direction), decaying
-  // with a 20 s time constant.
+  // with a gnss_return_decay_s time constant: the GNSS part of the step at
+  // the return (the INS part is the outage's drift, which the return
+  // takes out).
   double gnss_return_jump_m = 0.15;
+  double gnss_return_decay_s = 20.0;
+  // The outage as an INS dead-reckons it (issue 43; false: the quadratic
+  // growth above): a velocity bias (error linear in time), an acceleration
+  // bias (quadratic) and a heading error growing linearly to
+  // outage_heading_drift_deg at its end (in the attitude too), which turns
+  // the distance travelled (the error across the track grows with it),
+  // together outage_drift_m horizontally at the outage's end; vertically
+  // about 15 % of that.
+  bool outage_ins_drift = false;
+  double outage_heading_drift_deg = 0.1;
+  // How much the claimed horizontal and vertical sd grow through the
+  // outage, at its end. 0: the solution does not own up to its outage (its
+  // sd stay as before it).
+  double outage_sd_growth_m = 0.2;
+  // > 0: the outage is placed on the drive (outage_start_s is then ignored)
+  // to end where no crossing of the street lies for at least this many
+  // metres ahead (or as many as the street has), with crossings inside it:
+  // the control after the GNSS returns cannot tell which part of the
+  // return's step was wrong. The outage keeps outage_duration_s unless the
+  // drive's start cuts it.
+  double outage_clear_after_m = 0.0;
   // Multipath: sudden switches of the cross-track error, at
   // num_multipath_switches random places of the drive, each by
   // multipath_jump_m (times 0.7-1.3, the sign alternating so the error
@@ -298,6 +321,10 @@ struct SimulationOptions {
 //   demo       ~180 m, 3 crossings, ~55 exposures: the quick end-to-end run.
 //   urban      ~1 km, 12 crossings, facades, parked vehicles, drift to 2 m.
 //   outage     ~1.2 km with a 70 s GNSS outage, error growing to 3 m.
+//   long_outage  660 m, 6 crossings, a 49 s outage over ~360 m whose INS
+//              error grows to 3 m (velocity and acceleration bias, heading
+//              drift), a 3 m step when GNSS returns, sd that do not grow,
+//              two crossings inside it and 140 m without one after it.
 //   sparse     ~1.5 km, 4 crossings far apart.
 //   ambiguity  drift of ~1 m ACROSS the road, i.e. one band period along
 //              the bands' repetition direction.

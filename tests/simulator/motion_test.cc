@@ -88,6 +88,93 @@ TEST(Motion, ErrorGrowsDuringAnOutageAndDropsWhenGnssReturns) {
   EXPECT_LT(motion.measured[k].sd_enu_m.x(), 0.3);
 }
 
+// The field's long outage (issue 43): the INS error grows from a velocity
+// and an acceleration bias and a heading error times the distance, to
+// outage_drift_m at its end; the GNSS part of the return's step is the
+// error just after it, decaying; the stated sd need not grow.
+TEST(Motion, InsOutageGrowsToItsDriftAndStepsBackWhenGnssReturns) {
+  SimulationOptions options = MotionOptions();
+  options.drift_along_track_m = 0.05;
+  options.drift_cross_track_m = 0.05;
+  options.drift_vertical_m = 0.02;
+  options.heading_drift_deg = 0.005;
+  options.outage_start_s = 20.0;
+  options.outage_duration_s = 45.0;
+  options.outage_drift_m = 3.0;
+  options.outage_ins_drift = true;
+  options.outage_heading_drift_deg = 0.2;
+  options.outage_sd_growth_m = 0.0;
+  options.gnss_return_jump_m = 1.0;
+  options.gnss_return_decay_s = 5.0;
+  const World world = BuildWorld(options);
+  const VehicleMotion motion = SimulateMotion(options, world, FrameOf(options));
+  ASSERT_GT(motion.outage_end_time, motion.outage_begin_time);
+  auto index_at = [&](double time) {
+    size_t k = 0;
+    while (k + 1 < motion.truth.size() && motion.truth[k].time < time) ++k;
+    return k;
+  };
+  const double t0 = motion.outage_begin_time;
+  const double t1 = motion.outage_end_time;
+  const size_t last = index_at(t1) - 1;  // the last sample in the outage
+  const size_t first_after = index_at(t1);
+  const Eigen::Vector3d end = motion.position_error_enu[last];
+  const Eigen::Vector3d after = motion.position_error_enu[first_after];
+  // 3 m of INS error (plus the small drift) at the end, 15 % vertically.
+  EXPECT_NEAR(end.head<2>().norm(), 3.0, 0.15);
+  EXPECT_NEAR(std::abs(end.z()), 0.45, 0.05);
+  // Growing from nothing: a tenth of the way in, a small share of it.
+  EXPECT_LT(motion.position_error_enu[index_at(t0 + 4.5)].head<2>().norm(),
+            0.6);
+  // When GNSS returns, the error is the GNSS part (1 m), then decays.
+  EXPECT_NEAR(after.head<2>().norm(), 1.0, 0.15);
+  EXPECT_GT((end - after).norm(), 2.0);  // the return's step
+  EXPECT_LT(motion.position_error_enu[index_at(t1 + 10.0)].head<2>().norm(),
+            0.25);
+  // The heading error grows linearly to 0.2 degrees at the end.
+  EXPECT_NEAR(motion.attitude_error_rad[last].z() / kDeg, 0.2, 0.05);
+  // The solution does not own up to its outage: its sd stay flat.
+  EXPECT_EQ(motion.measured[last].sd_enu_m, motion.measured[0].sd_enu_m);
+}
+
+// Placed as the field has it: crossings of the street inside the outage,
+// none for outage_clear_after_m after it.
+TEST(Motion, OutagePlacedWithCrossingsInsideAndNoneJustAfter) {
+  SimulationOptions options = MotionOptions();
+  options.road_length_m = 900.0;
+  options.num_crossings = 6;
+  options.min_crossing_spacing_m = 20.0;
+  options.outage_duration_s = 30.0;
+  options.outage_ins_drift = true;
+  options.outage_clear_after_m = 120.0;
+  int placed = 0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    options.seed = seed;
+    const World world = BuildWorld(options);
+    const VehicleMotion motion =
+        SimulateMotion(options, world, FrameOf(options));
+    auto s_at = [&](double time) {
+      size_t k = 0;
+      while (k + 1 < motion.truth.size() && motion.truth[k].time < time) ++k;
+      return motion.s_m[k];
+    };
+    const double s_begin = s_at(motion.outage_begin_time);
+    const double s_end = s_at(motion.outage_end_time);
+    EXPECT_NEAR(motion.outage_end_time - motion.outage_begin_time, 30.0, 0.1);
+    int inside = 0;
+    double next = motion.s_m.back();
+    for (const Crossing& c : world.crossings) {
+      if (!c.in_street) continue;
+      inside += c.s_max > s_begin && c.s_max < s_end;
+      if (c.s_min > s_end) next = std::min(next, c.s_min);
+    }
+    EXPECT_GE(inside, 1) << seed;
+    placed += next - s_end >= 120.0;
+  }
+  // Where the street's crossings leave 120 m free (most seeds).
+  EXPECT_GE(placed, 4);
+}
+
 TEST(Motion, TruthFollowsTheRightLaneAtImuHeightWithRoadAttitude) {
   SimulationOptions options = MotionOptions();
   options.suspension_roll_deg = 0.0;

@@ -60,6 +60,33 @@ TEST(RandomPreset, IsDeterministicValidAndCoversTheContract) {
   EXPECT_GT(short_streets, 50);
 }
 
+// The outage kind's outages are the field's (issue 43): 10-60 s, 1-5 m of
+// INS error, the GNSS's own error at the return, room for 150 m without a
+// crossing after them where the limits allow.
+TEST(RandomPreset, OutagesAreTheFields) {
+  int outages = 0, flat_sd = 0;
+  for (uint64_t seed = 1; seed <= 300; ++seed) {
+    SimulationOptions o;
+    ASSERT_EQ(DrawRandomOptions(seed, RandomPresetLimits(), &o), "");
+    if (o.scenario != "outage") continue;
+    ++outages;
+    EXPECT_TRUE(o.outage_ins_drift) << seed;
+    EXPECT_GE(o.outage_duration_s, 10.0) << seed;
+    EXPECT_LE(o.outage_duration_s, 60.0) << seed;
+    EXPECT_GE(o.outage_drift_m, 1.0) << seed;
+    EXPECT_LE(o.outage_drift_m, 5.0) << seed;
+    EXPECT_LE(o.outage_drift_m + o.gnss_return_jump_m, 5.5) << seed;
+    EXPECT_EQ(o.outage_clear_after_m, 150.0) << seed;
+    EXPECT_GE(o.road_length_m,
+              o.outage_duration_s * o.vehicle_speed_mps + 150.0)
+        << seed;
+    flat_sd += o.outage_sd_growth_m == 0.0;
+  }
+  EXPECT_GT(outages, 15);
+  EXPECT_GT(flat_sd, 3);
+  EXPECT_LT(flat_sd, outages - 3);
+}
+
 TEST(RandomPreset, LimitsTheRoadLength) {
   RandomPresetLimits limits;
   limits.max_road_length_m = 200.0;
