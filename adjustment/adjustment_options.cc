@@ -81,6 +81,7 @@ std::string AdjustmentOptions::Check() const {
       return Violation(p.name, p.value, "must be finite and > 0");
     }
   }
+  if (const std::string why = never_worse.Check(); !why.empty()) return why;
   if (const std::string why = sideways_switches.Check(); !why.empty()) {
     return "sideways_switches." + why;
   }

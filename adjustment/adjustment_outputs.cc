@@ -10,6 +10,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "adjustment/input_guard.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
@@ -39,9 +40,16 @@ bool FillTrajectory(const OutputContext& context, const State& state,
       summary.message = "the corrected trajectory is not finite";
       return false;
     }
+    // Where the guard keeps the input, the input's pose and stated sd.
+    const bool guarded = context.guard != nullptr &&
+                         context.guard->AdjustedWeight(sample.time) < 1.0;
+    if (guarded) {
+      corrected = GuardedPose(*context.guard, sample.time, corrected,
+                              trajectory.poses()[i]);
+    }
     result->corrected_poses.push_back(corrected);
     Eigen::Vector3d sd_enu = sample.sd_enu_m;
-    if (!context.sample_covariance.empty()) {
+    if (!context.sample_covariance.empty() && !guarded) {
       sd_enu =
           context.sample_covariance[i].diagonal().cwiseMax(0.0).cwiseSqrt();
       sd_h.push_back(std::hypot(sd_enu.x(), sd_enu.y()));
@@ -348,6 +356,11 @@ bool OutputPoseAt(const OutputContext& context, const State& state, double time,
   }
   *pose = state.correction.Apply(time, ins_pose);
   pose->p_enu += ExposureOffsetAt(state, time);
+  if (context.guard != nullptr && context.guard->AdjustedWeight(time) < 1.0) {
+    Pose input;
+    if (!trajectory.InterpolatePose(time, &input)) return false;
+    *pose = GuardedPose(*context.guard, time, *pose, input);
+  }
   return true;
 }
 

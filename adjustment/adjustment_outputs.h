@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "adjustment/adjustment_state.h"
+#include "adjustment/control_guard.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "adjustment/trajectory_jumps.h"
 
@@ -24,12 +25,15 @@ struct OutputContext {
   bool adjusted = true;
   // Posterior covariance of each sample's position (ENU), or empty.
   std::vector<Eigen::Matrix3d> sample_covariance;
+  // Where the guard keeps the input trajectory (control_guard.h), or null.
+  const GuardResult* guard = nullptr;
   std::function<void(const std::string&)> warn;
 };
 
 // The corrected body pose at `time`: the correction applied to the
-// de-jumped INS trajectory, or the input trajectory itself when not
-// adjusted. False outside the trajectory.
+// de-jumped INS trajectory (blended into the input where the guard keeps
+// it), or the input trajectory itself when not adjusted. False outside the
+// trajectory.
 bool OutputPoseAt(const OutputContext& context, const State& state, double time,
                   Pose* pose);
 

@@ -171,6 +171,46 @@ void WidenByLines(const AdjustmentOptions& options, const State& state,
 
 }  // namespace
 
+void SetKnotPriors(const Context& context, const DejumpedTrajectory& dejumped,
+                   State* state) {
+  state->knot_prior.clear();
+  state->knot_extra_variance_m2.clear();
+  if (dejumped.num_jumps == 0 && dejumped.switches.empty()) return;
+  const AdjustmentOptions& options = context.options;
+  const Trajectory& trajectory = *context.input.trajectory;
+  int previous_sample = 0;
+  for (int k = 0; k < state->correction.num_knots(); ++k) {
+    const double t = std::clamp(state->correction.KnotTime(k),
+                                trajectory.start_time(), trajectory.end_time());
+    const int i = std::max(0, trajectory.FindSegment(t));
+    Pose pose;
+    context.InsPoseAt(t, &pose);
+    const Eigen::Matrix3d R_track_enu =
+        state->correction.Frame(pose).transpose();
+    const Eigen::AngleAxisd rotation(dejumped.prior_rotation_offset[i]);
+    Eigen::Matrix<double, 6, 1> b;
+    b.head<3>() = R_track_enu * (rotation.angle() * rotation.axis());
+    b.tail<3>() = R_track_enu * dejumped.prior_position_offset[i];
+    state->knot_prior.push_back(b);
+    // What the error gains beyond its process between the two knots'
+    // samples (a jump that stays a step, an outage's closure; a sideways
+    // switch's across the track only).
+    Eigen::Vector3d extra = Eigen::Vector3d::Zero();
+    for (int j = previous_sample + 1; k > 0 && j <= i; ++j) {
+      extra += Eigen::Vector3d::Constant(dejumped.innovation_variance_m2[j]);
+      // In ENU (track_frame false) the cross-track axis is no axis.
+      const double across = dejumped.cross_track_innovation_variance_m2[j];
+      if (options.track_frame) {
+        extra.y() += across;
+      } else {
+        extra += Eigen::Vector3d::Constant(across);
+      }
+    }
+    state->knot_extra_variance_m2.push_back(extra);
+    previous_sample = i;
+  }
+}
+
 void InitialiseCorrection(const Context& context, State* state) {
   const AdjustmentOptions& options = context.options;
   const Trajectory& trajectory = *context.input.trajectory;
@@ -180,43 +220,7 @@ void InitialiseCorrection(const Context& context, State* state) {
   state->rig_corrections.assign(context.input.rig->cameras.size(),
                                 std::array<double, kRigCorrectionSize>{});
   context.summary->num_knots = state->correction.num_knots();
-  if (context.dejumped.num_jumps > 0 || !context.dejumped.switches.empty()) {
-    int previous_sample = 0;
-    for (int k = 0; k < state->correction.num_knots(); ++k) {
-      const double t =
-          std::clamp(state->correction.KnotTime(k), trajectory.start_time(),
-                     trajectory.end_time());
-      const int i = std::max(0, trajectory.FindSegment(t));
-      Pose pose;
-      context.InsPoseAt(t, &pose);
-      const Eigen::Matrix3d R_track_enu =
-          state->correction.Frame(pose).transpose();
-      const Eigen::AngleAxisd rotation(
-          context.dejumped.prior_rotation_offset[i]);
-      Eigen::Matrix<double, 6, 1> b;
-      b.head<3>() = R_track_enu * (rotation.angle() * rotation.axis());
-      b.tail<3>() = R_track_enu * context.dejumped.prior_position_offset[i];
-      state->knot_prior.push_back(b);
-      // What the error gains beyond its process between the two knots'
-      // samples (a jump that stays a step, an outage's closure; a sideways
-      // switch's across the track only).
-      Eigen::Vector3d extra = Eigen::Vector3d::Zero();
-      for (int j = previous_sample + 1; k > 0 && j <= i; ++j) {
-        extra += Eigen::Vector3d::Constant(
-            context.dejumped.innovation_variance_m2[j]);
-        // In ENU (track_frame false) the cross-track axis is no axis.
-        const double across =
-            context.dejumped.cross_track_innovation_variance_m2[j];
-        if (options.track_frame) {
-          extra.y() += across;
-        } else {
-          extra += Eigen::Vector3d::Constant(across);
-        }
-      }
-      state->knot_extra_variance_m2.push_back(extra);
-      previous_sample = i;
-    }
-  }
+  SetKnotPriors(context, context.dejumped, state);
   if (options.sideslip_sigma_rad > 0.0) {
     state->model.motion_sigma_rad = ChooseVehicleMotion(context, state);
   }

@@ -20,6 +20,13 @@ namespace adjustment_internal {
 // (state->motion, state->model.motion_sigma_rad).
 void InitialiseCorrection(const Context& context, State* state);
 
+// The prior's centre at each knot and what the error gains between knots
+// beyond its process (State::knot_prior, knot_extra_variance_m2), from
+// `dejumped`'s prior offsets and innovation variances; empty without jumps
+// or switches.
+void SetKnotPriors(const Context& context, const DejumpedTrajectory& dejumped,
+                   State* state);
+
 // The error model the adjustment starts from: the position process fitted
 // to the consistent crossings' discrepancies, the attitude from the
 // trajectory's own claimed sd, the exposures' jitter where the positions

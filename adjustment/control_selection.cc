@@ -236,6 +236,19 @@ std::vector<GaussMarkovFit> FitAxes(
   return FitAxesWith(crossings, use, {}, fit_options);
 }
 
+std::vector<GaussMarkovFit> FitAxes(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<bool>& use,
+    const std::vector<CrossingDiscrepancy>& witnesses,
+    const GaussMarkovFitOptions& fit_options) {
+  return FitAxesWith(crossings, use, witnesses, fit_options);
+}
+
+std::vector<CrossingDiscrepancy> ControlWitnesses(
+    const AdjustmentOptions& options, const State& state) {
+  return Witnesses(options, state);
+}
+
 std::vector<CrossingVerdict> SelectConsistentCrossings(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<std::string>& names,

@@ -78,6 +78,19 @@ std::vector<GaussMarkovFit> FitAxes(
     const std::vector<CrossingDiscrepancy>& crossings,
     const std::vector<bool>& use, const GaussMarkovFitOptions& fit_options);
 
+// The same with the witnesses (SelectConsistentCrossings) on the axes they
+// measure.
+std::vector<GaussMarkovFit> FitAxes(
+    const std::vector<CrossingDiscrepancy>& crossings,
+    const std::vector<bool>& use,
+    const std::vector<CrossingDiscrepancy>& witnesses,
+    const GaussMarkovFitOptions& fit_options);
+
+// The other control that votes in the crossings' tests: whole dashes
+// (along-track) and the road lines per time bin (across the track only).
+std::vector<CrossingDiscrepancy> ControlWitnesses(
+    const AdjustmentOptions& options, const State& state);
+
 // The Gauss-Markov fit of the position process from the options' bounds.
 GaussMarkovFitOptions PositionFitOptions(const AdjustmentOptions& options);
 

@@ -29,6 +29,8 @@
 #include "adjustment/blunder_loop.h"
 #include "adjustment/control_selection.h"
 #include "adjustment/covariance.h"
+#include "adjustment/input_guard.h"
+#include "adjustment/outage_model.h"
 #include "adjustment/trajectory_jumps.h"
 
 namespace zebrageo {
@@ -154,6 +156,12 @@ AdjustmentResult AdjustTrajectory(
 
   State state;
   const CrossingTable crossings = BuildState(context, &state);
+  // What each jump means (an outage's drift, the GNSS's error, or both):
+  // the reading that keeps the most control.
+  for (const std::string& sentence :
+       adjustment_internal::ChooseOutageModel(&context, crossings, &state)) {
+    context.Warn(sentence);
+  }
   SelectControl(context, crossings, &state);
   const adjustment_internal::StateRms before =
       adjustment_internal::MeasureState(*input.rig, state);
@@ -173,6 +181,12 @@ AdjustmentResult AdjustTrajectory(
   adjustment_internal::EvaluateControlPoints(options, *input.rig, &state);
   const adjustment_internal::StateRms after =
       adjustment_internal::MeasureState(*input.rig, state);
+  // Never worse than the input by the survey's own control: where the
+  // adjusted trajectory fits the matched crossings worse, the input stays.
+  GuardResult guard;
+  if (adjusted) guard = adjustment_internal::GuardAdjustment(context, state);
+  summary.guard_verdicts = guard.verdicts;
+  summary.kept_input = guard.kept;
 
   OutputContext output;
   output.options = &options;
@@ -180,6 +194,7 @@ AdjustmentResult AdjustTrajectory(
   output.dejumped = &context.dejumped;
   output.adjusted = adjusted;
   output.warn = [&context](const std::string& w) { context.Warn(w); };
+  output.guard = guard.Fired() ? &guard : nullptr;
   if (adjusted) {
     output.sample_covariance = adjustment_internal::SampleCovariance(
         context, &state, solver.problem());
@@ -189,7 +204,7 @@ AdjustmentResult AdjustTrajectory(
   }
   adjustment_internal::SummariseFinalState(output, state, before, after,
                                            crab_before_deg, &summary);
-  summary.corrected = adjusted;
+  summary.corrected = adjusted && !guard.KeepsInputEverywhere();
   summary.line_control_only = adjusted && summary.num_control_crossings == 0 &&
                               summary.num_check_crossings == 0 &&
                               !state.lines.empty();

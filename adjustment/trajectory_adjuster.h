@@ -46,7 +46,9 @@
 #include <string>
 #include <vector>
 
+#include "adjustment/control_guard.h"
 #include "adjustment/line_control.h"
+#include "adjustment/never_worse_options.h"
 #include "adjustment/solver_options.h"
 #include "adjustment/trajectory_correction.h"
 #include "adjustment/trajectory_switches.h"
@@ -135,6 +137,10 @@ struct AdjustmentOptions {
   // correction measured on one side is not carried across with the error
   // the switch added.
   SidewaysSwitchOptions sideways_switches;
+  // Never worse than the input (issue 43): a GNSS outage's hypotheses
+  // tested against the control, and the guard that keeps the input where
+  // the adjusted trajectory fits the matched crossings worse.
+  NeverWorseOptions never_worse;
 
   // ---------------------------------------------------- control points
   // Each control vertex is observed as its exposure's stereo pair
@@ -393,6 +399,11 @@ struct AdjustmentSummary {
   Eigen::Vector3d attitude_significance = Eigen::Vector3d::Zero();
   // Jumps found in the input trajectory (GNSS returns).
   int num_jumps = 0;
+  // The guard (control_guard.h): each matched crossing placed with the
+  // input and the adjusted trajectory, and the stretches where the input
+  // was kept because the adjusted trajectory fitted them worse.
+  std::vector<GuardVerdict> guard_verdicts;
+  std::vector<KeptStretch> kept_input;
   // Posterior sd of the corrected positions (median over the samples, 0
   // when not computed).
   double median_posterior_sd_horizontal_m = 0.0;

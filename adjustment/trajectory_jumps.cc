@@ -6,34 +6,9 @@
 namespace zebrageo {
 namespace {
 
-// Samples [first, last] over which the offsets change: one jump, which may
-// take a few samples.
-struct JumpEvent {
-  int first = 0;
-  int last = 0;
-};
-
 bool OffsetChanges(const DejumpedTrajectory& d, int i) {
   return d.position_offset[i] != d.position_offset[i - 1] ||
          d.rotation_offset[i].angularDistance(d.rotation_offset[i - 1]) > 0.0;
-}
-
-// A sideways switch's steps are not jumps: their variance is the
-// cross-track axis's (MoveSwitchInnovations), and an outage's closure is
-// the jump's alone.
-std::vector<JumpEvent> JumpEvents(const DejumpedTrajectory& d) {
-  std::vector<JumpEvent> events;
-  const int n = static_cast<int>(d.position_offset.size());
-  for (int i = 1; i < n; ++i) {
-    if (!OffsetChanges(d, i)) continue;
-    if (!d.switch_step.empty() && d.switch_step[i]) continue;
-    if (!events.empty() && events.back().last == i - 1) {
-      events.back().last = i;
-    } else {
-      events.push_back({i, i});
-    }
-  }
-  return events;
 }
 
 // Share of a jump's closure at each sample of [start, jump.first) (zero
@@ -88,6 +63,24 @@ void MoveSwitchInnovations(const std::vector<Eigen::Vector3d>& sideways,
 }
 
 }  // namespace
+
+// A sideways switch's steps are not jumps: their variance is the
+// cross-track axis's (MoveSwitchInnovations), and an outage's closure is
+// the jump's alone.
+std::vector<JumpEvent> JumpEvents(const DejumpedTrajectory& d) {
+  std::vector<JumpEvent> events;
+  const int n = static_cast<int>(d.position_offset.size());
+  for (int i = 1; i < n; ++i) {
+    if (!OffsetChanges(d, i)) continue;
+    if (!d.switch_step.empty() && d.switch_step[i]) continue;
+    if (!events.empty() && events.back().last == i - 1) {
+      events.back().last = i;
+    } else {
+      events.push_back({i, i});
+    }
+  }
+  return events;
+}
 
 void SpreadOutageClosures(const Trajectory& trajectory,
                           DejumpedTrajectory* dejumped) {

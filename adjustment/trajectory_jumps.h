@@ -52,6 +52,17 @@ struct DejumpedTrajectory {
   std::vector<bool> switch_step;
 };
 
+// Samples [first, last] over which the offsets change: one jump, which may
+// take a few samples.
+struct JumpEvent {
+  int first = 0;
+  int last = 0;
+};
+
+// The jumps of `dejumped` in time order (a sideways switch's steps are
+// not jumps).
+std::vector<JumpEvent> JumpEvents(const DejumpedTrajectory& dejumped);
+
 // A step that departs from its neighbours' motion by more than threshold_m
 // (position) or threshold_rad (attitude), or by more than 8 times the
 // trajectory's median departure where that is larger, is a jump. A

@@ -1,5 +1,6 @@
 // `geometry_sweep [--seeds A-B] [--threads N] [--only KIND] [--max-length M]
-//                 [--no-rematch] [--no-lines] [--verbose SEED -o DIR]`
+//                 [--no-rematch] [--no-lines] [--no-never-worse]
+//                 [--verbose SEED -o DIR]`
 //
 // Issue 17's geometry sweep: for each seed, a random simulated survey in
 // memory (the random preset, no images), a reconstruction and image
@@ -78,6 +79,9 @@ int Main(int argc, char** argv) {
                "pass of `zebrageo run`)");
   app.add_flag("!--no-lines", options.lines,
                "zebra crossings only (no synthesised road lines)");
+  app.add_flag("!--no-never-worse", options.never_worse,
+               "the adjustment without its outage readings and its guard "
+               "(issue 43), to compare");
   int log_level = -1;
   app.add_option("--log", log_level,
                  "the stages' logs to stderr, with VLOG up to this level "

@@ -436,6 +436,10 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     AdjustmentOptions adjustment;
     adjustment.solver.num_threads = 1;
     adjustment.log_warnings = false;
+    if (!options.never_worse) {
+      adjustment.never_worse.outage_min_jump_m = 0.0;
+      adjustment.never_worse.guard_sigmas = 0.0;
+    }
     AdjustmentData data =
         AdjustmentDataOf(survey, reconstruction.vertices, match.matches);
     std::vector<std::string> warnings;

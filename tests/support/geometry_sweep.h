@@ -60,6 +60,10 @@ struct GeometrySweepOptions {
   // second pass when the adjustment had too few crossings. false: zebra
   // crossings only.
   bool lines = true;
+  // The adjustment's "never worse than the input" (issue 43): its outage
+  // readings and its guard (AdjustmentOptions::never_worse). false: both
+  // off, the adjustment as before them.
+  bool never_worse = true;
 
   std::string Check() const;
 };
