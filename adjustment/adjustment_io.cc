@@ -1,6 +1,8 @@
 #include "adjustment/adjustment_io.h"
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -110,6 +112,18 @@ AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
     r.tie_points = AdjustmentRecord::TiePoints{
         ties->images_read, ties->images_missing, ties->matches,
         ties->tracks,      ties->observations,   ties->time_in_seconds};
+  }
+  for (const GuardVerdict& v : s.guard_verdicts) {
+    r.guard.crossings.push_back(
+        {v.id, v.used, v.input_misfit_m, v.adjusted_misfit_m, v.z, v.worse});
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto finite = [nan](double t) { return std::isfinite(t) ? t : nan; };
+  for (const KeptStretch& k : s.kept_input) {
+    r.guard.input_kept.push_back({finite(k.ramp_begin_s), finite(k.begin_s),
+                                  finite(k.end_s), finite(k.ramp_end_s),
+                                  k.crossings, k.input_misfit_m,
+                                  k.adjusted_misfit_m});
   }
   r.warnings = data.warnings;
   r.warnings.insert(r.warnings.end(), s.warnings.begin(), s.warnings.end());

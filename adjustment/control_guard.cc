@@ -27,7 +27,8 @@ Eigen::Vector3d MedianOf(const std::vector<Eigen::Vector3d>& points) {
 // share of the adjusted trajectory's misfit.
 constexpr double kRejectedInputShare = 0.5;
 
-GuardVerdict VerdictOf(const GuardCrossing& c, double guard_sigmas) {
+GuardVerdict VerdictOf(const GuardCrossing& c,
+                       const NeverWorseOptions& options) {
   GuardVerdict v;
   v.id = c.id;
   v.first_time_s = c.first_time_s;
@@ -48,7 +49,8 @@ GuardVerdict VerdictOf(const GuardCrossing& c, double guard_sigmas) {
   // apart.
   if (d.norm() < 1e-3 || !(spread > 0.0)) return v;
   v.z = d.dot(adj + in) / spread;
-  v.worse = guard_sigmas > 0.0 && v.z > guard_sigmas;
+  v.worse = options.guard_sigmas > 0.0 && v.z > options.guard_sigmas &&
+            d.norm() >= options.guard_min_difference_m;
   // A crossing the adjustment rejected may be wrong itself (repainted,
   // moved in the database): the input fitting it a little better is no
   // evidence against the adjusted trajectory. It objects only where the
@@ -96,7 +98,7 @@ GuardResult GuardAgainstInput(const std::vector<GuardCrossing>& crossings,
         c.adjusted_enu.size() != c.database_enu.size()) {
       continue;
     }
-    result.verdicts.push_back(VerdictOf(c, options.guard_sigmas));
+    result.verdicts.push_back(VerdictOf(c, options));
   }
   std::sort(result.verdicts.begin(), result.verdicts.end(),
             [](const GuardVerdict& a, const GuardVerdict& b) {

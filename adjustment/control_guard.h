@@ -14,11 +14,11 @@
 //   |r_adj - e|^2 - |r_in - e|^2 = d.(r_adj + r_in) - 2 d.e > 0,
 // d = r_adj - r_in (the two trajectories' difference there, known). The
 // crossing is worse when z = d.(r_adj + r_in) / (2 |sigma o d|) exceeds
-// NeverWorseOptions::guard_sigmas. A crossing the adjustment rejected
-// (repainted, moved in the database: wrong itself, not the trajectory)
-// objects only where the input also fits it at least twice as well as the
-// adjusted trajectory: a wrong crossing 1.5 m off that the input misses by
-// 1 m says nothing of either.
+// NeverWorseOptions::guard_sigmas and |d| guard_min_difference_m. A crossing
+// the adjustment rejected (repainted, moved in the database: wrong itself, not
+// the trajectory) objects only where the input also fits it at least twice as
+// well as the adjusted trajectory: a wrong crossing 1.5 m off that the input
+// misses by 1 m says nothing of either.
 //
 // Plain data in and out: this file knows nothing of the adjustment's state.
 // Frames: ENU metres; times in the trajectory's seconds.

@@ -31,6 +31,10 @@ std::string NeverWorseOptions::Check() const {
   if (!(guard_sigmas >= 0.0)) {
     return Violation("guard_sigmas", guard_sigmas, "must be >= 0");
   }
+  if (!(guard_min_difference_m >= 0.0)) {
+    return Violation("guard_min_difference_m", guard_min_difference_m,
+                     "must be >= 0");
+  }
   if (!(guard_crossing_sigma_m > 0.0)) {
     return Violation("guard_crossing_sigma_m", guard_crossing_sigma_m,
                      "must be > 0");

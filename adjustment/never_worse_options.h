@@ -33,9 +33,13 @@ struct NeverWorseOptions {
   // or rejected) is placed with the input trajectory and with the adjusted
   // one: where the adjusted trajectory is farther from the database than
   // the input by more than guard_sigmas standard deviations of the
-  // database's own error (its crossing offset and vertex sigma), the input
-  // is kept over that stretch. 0 disables the guard.
-  double guard_sigmas = 2.0;
+  // database's own error (its crossing offset and vertex sigma; 3: one
+  // chance in 700 where both are as good), the input is kept over that
+  // stretch. 0 disables the guard.
+  double guard_sigmas = 3.0;
+  // ... and only where the two trajectories place it at least this far
+  // apart (metres): closer, nothing the user would see changes.
+  double guard_min_difference_m = 0.05;
   // The database's error per crossing the test assumes at least (per axis,
   // metres): its stated vertex sigma averaged over the vertices plus the
   // crossing's systematic offset (SURVEY_FORMAT.md: 5-15 cm).

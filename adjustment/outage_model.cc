@@ -101,6 +101,55 @@ double TimeOf(const Trajectory& trajectory, int i) {
   return trajectory.samples()[i].time;
 }
 
+// The prior's centre at `time` (ENU), linear between samples.
+Eigen::Vector3d PriorOffsetAt(const Trajectory& trajectory,
+                              const DejumpedTrajectory& dejumped, double time) {
+  const int i = trajectory.FindSegment(time);
+  if (i < 0) return Eigen::Vector3d::Zero();
+  const double t0 = TimeOf(trajectory, i);
+  const double t1 = TimeOf(trajectory, i + 1);
+  const double u =
+      t1 > t0 ? std::clamp((time - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+  return (1.0 - u) * dejumped.prior_position_offset[i] +
+         u * dejumped.prior_position_offset[i + 1];
+}
+
+// The vehicle's motion as a witness of a reading (vehicle_motion.h): the
+// INS drifting through an outage from a velocity error moves across its
+// own heading, by the error's rate over the speed; the prior's centre of
+// the right reading takes that motion out, and leaves the crab of the
+// trajectory moved to it as steady as the vehicle's yaw misalignment and
+// the GNSS's slow drift make it. The Gaussian log-likelihood (each
+// constraint's lateral sigma) of those crab angles about their median, over
+// the constraints within [begin_s, end_s] whose chord does not span the
+// jump.
+double CrabLogLikelihood(const Trajectory& trajectory,
+                         const DejumpedTrajectory& dejumped, const State& state,
+                         double begin_s, double end_s, double jump_begin_s,
+                         double jump_end_s) {
+  std::vector<double> crab, sigma;
+  for (const VehicleMotionSample& m : state.motion) {
+    if (m.times[1] < begin_s || m.times[1] > end_s) continue;
+    if (m.times[0] <= jump_end_s && m.times[2] >= jump_begin_s) continue;
+    const double length = (m.ins[2].p_enu - m.ins[0].p_enu).head<2>().norm();
+    if (!(length > 0.0) || !(m.sigma_lateral_rad > 0.0)) continue;
+    const Eigen::Vector3d p0 =
+        m.ins[0].p_enu + PriorOffsetAt(trajectory, dejumped, m.times[0]);
+    const Eigen::Vector3d p2 =
+        m.ins[2].p_enu + PriorOffsetAt(trajectory, dejumped, m.times[2]);
+    crab.push_back((m.ins[1].q_enu_body.inverse() * (p2 - p0)).y() / length);
+    sigma.push_back(m.sigma_lateral_rad);
+  }
+  if (crab.empty()) return 0.0;
+  const double centre = Median(crab);
+  double log_likelihood = 0.0;
+  for (size_t k = 0; k < crab.size(); ++k) {
+    const double z = (crab[k] - centre) / sigma[k];
+    log_likelihood -= 0.5 * z * z;
+  }
+  return log_likelihood;
+}
+
 }  // namespace
 
 namespace {
@@ -250,6 +299,17 @@ std::vector<std::string> ChooseOutageModel(Context* context,
       continue;
     }
     const double t_jump = TimeOf(trajectory, jump.first);
+    // Where the readings differ: from the previous jump to the next one.
+    const double window_begin = TimeOf(trajectory, floor);
+    double window_end = trajectory.end_time();
+    for (const JumpEvent& next : jumps) {
+      if (next.first > jump.last) {
+        window_end = TimeOf(trajectory, next.first);
+        break;
+      }
+    }
+    const double jump_begin = TimeOf(trajectory, jump.first - 1);
+    const double jump_end = TimeOf(trajectory, jump.last);
     // The readings, coarse first (the outage's length, the GNSS part's
     // decay), then the outage's growth and a half share at the best
     // length.
@@ -266,7 +326,10 @@ std::vector<std::string> ChooseOutageModel(Context* context,
       DejumpedTrajectory trial = d;
       ApplyOutageHypothesis(trajectory, jump, floor, hypotheses[k], &trial);
       SetKnotPriors(*context, trial, state);
-      const Score score = ScoreOf(*context, crossings, *state);
+      Score score = ScoreOf(*context, crossings, *state);
+      score.log_likelihood +=
+          CrabLogLikelihood(trajectory, trial, *state, window_begin, window_end,
+                            jump_begin, jump_end);
       VLOG(1) << "outage model, jump of " << J.norm() << " m at "
               << t_jump - trajectory.start_time()
               << " s: " << hypotheses[k].name << ": keeps " << score.crossings

@@ -20,9 +20,12 @@
 //   - half of each.
 // Each is tested against the crossings (and the road lines and whole
 // dashes) as the control selection tests them (control_selection.h): the
-// hypothesis that keeps the most control wins, the likelihood of the
-// Gauss-Markov fit deciding between those that keep as much; the one found
-// stays unless another keeps more, or as much far more likely.
+// hypothesis that keeps the most control wins; between those that keep as
+// much, the likelihood decides: of the Gauss-Markov fit of the kept
+// control, and of the vehicle's motion (vehicle_motion.h: an INS drifting
+// from a velocity error moves across its own heading, which the right
+// reading's prior takes out). The one found stays unless another keeps
+// more, or as much far more likely.
 //
 // Frames: ENU for the prior offsets; times in the trajectory's seconds.
 #ifndef ZEBRAGEO_ADJUSTMENT_OUTAGE_MODEL_H_

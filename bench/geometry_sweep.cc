@@ -1,5 +1,6 @@
 // `geometry_sweep [--seeds A-B] [--threads N] [--only KIND] [--max-length M]
 //                 [--no-rematch] [--no-lines] [--no-never-worse]
+//                 [--no-outage-readings] [--no-images]
 //                 [--verbose SEED -o DIR]`
 //
 // Issue 17's geometry sweep: for each seed, a random simulated survey in
@@ -79,14 +80,20 @@ int Main(int argc, char** argv) {
                "pass of `zebrageo run`)");
   app.add_flag("!--no-lines", options.lines,
                "zebra crossings only (no synthesised road lines)");
-  app.add_flag("!--no-never-worse", options.never_worse,
+  app.add_flag("!--no-images", options.dump_images,
+               "--verbose: the survey without its images");
+  bool never_worse = true;
+  app.add_flag("!--no-never-worse", never_worse,
                "the adjustment without its outage readings and its guard "
                "(issue 43), to compare");
+  app.add_flag("!--no-outage-readings", options.outage_readings,
+               "the adjustment without its outage readings (the guard on)");
   int log_level = -1;
   app.add_option("--log", log_level,
                  "the stages' logs to stderr, with VLOG up to this level "
                  "(one seed at a time)");
   CLI11_PARSE(app, argc, argv);
+  if (!never_worse) options.outage_readings = options.guard = false;
   FLAGS_logtostderr = true;
   FLAGS_minloglevel = log_level < 0 ? google::GLOG_ERROR : google::GLOG_INFO;
   FLAGS_v = std::max(0, log_level);

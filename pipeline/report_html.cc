@@ -359,6 +359,22 @@ std::string RenderHtml(const json& report, const ReportData& data) {
     html << "<p>Corrections applied to the trajectory:</p>\n"
          << KeyValueTable(report["corrections"]);
   }
+  // Never worse than the input (issue 43): each matched crossing placed
+  // with the input and with the adjusted trajectory.
+  const json guard = report.value("adjustment", json::object())
+                         .value("guard", json::object());
+  if (!guard.value("crossings", json::array()).empty()) {
+    html << "<h2>Compared with the input trajectory</h2>\n<p>"
+         << (guard.value("input_kept", false)
+                 ? "The adjusted trajectory fits some matched crossings worse "
+                   "than the input trajectory does: there the input "
+                   "trajectory is kept (see the warnings)."
+                 : "The adjusted trajectory fits every matched crossing at "
+                   "least as well as the input trajectory does.")
+         << " Each crossing's distance from the database, placed with "
+            "each trajectory:</p>\n"
+         << ArrayTable(guard["crossings"]);
+  }
 
   html << "<h2>Trajectory</h2>\n"
        << TrajectoryMap(data) << CorrectionPlots(data);

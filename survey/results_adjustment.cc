@@ -173,6 +173,59 @@ AdjustmentRecord::Model ReadModel(const Fields& f) {
   return m;
 }
 
+// A time that may be open (null): NaN.
+json TimeJson(double t) { return std::isfinite(t) ? json(t) : json(nullptr); }
+
+json GuardJson(const AdjustmentRecord::Guard& g) {
+  json crossings = json::array();
+  for (const AdjustmentRecord::Guard::Crossing& c : g.crossings) {
+    crossings.push_back({{"crossing_id", c.crossing_id},
+                         {"used", c.used},
+                         {"input_misfit_m", c.input_misfit_m},
+                         {"adjusted_misfit_m", c.adjusted_misfit_m},
+                         {"z", c.z},
+                         {"worse", c.worse}});
+  }
+  json kept = json::array();
+  for (const AdjustmentRecord::Guard::Stretch& s : g.input_kept) {
+    kept.push_back({{"blend_begin_time_s", TimeJson(s.blend_begin_time_s)},
+                    {"begin_time_s", TimeJson(s.begin_time_s)},
+                    {"end_time_s", TimeJson(s.end_time_s)},
+                    {"blend_end_time_s", TimeJson(s.blend_end_time_s)},
+                    {"crossings", s.crossings},
+                    {"input_misfit_m", s.input_misfit_m},
+                    {"adjusted_misfit_m", s.adjusted_misfit_m}});
+  }
+  return {{"input_kept", !g.input_kept.empty()},
+          {"note",
+           "each matched crossing (used or rejected) placed with the input "
+           "and with the adjusted trajectory; where the adjusted one is "
+           "farther from the database beyond the database's own error, the "
+           "input trajectory is kept (input_kept_stretches)"},
+          {"input_kept_stretches", kept},
+          {"crossings", crossings}};
+}
+
+AdjustmentRecord::Guard ReadGuard(const Fields& f) {
+  AdjustmentRecord::Guard g;
+  for (const json& value : f.At("crossings")) {
+    const Fields c(value, f.name());
+    g.crossings.push_back({c.Get<std::string>("crossing_id"),
+                           c.Get<bool>("used"), c.Number("input_misfit_m"),
+                           c.Number("adjusted_misfit_m"), c.Number("z"),
+                           c.Get<bool>("worse")});
+  }
+  for (const json& value : f.At("input_kept_stretches")) {
+    const Fields s(value, f.name());
+    g.input_kept.push_back(
+        {s.Number("blend_begin_time_s"), s.Number("begin_time_s"),
+         s.Number("end_time_s"), s.Number("blend_end_time_s"),
+         s.Get<std::vector<std::string>>("crossings"),
+         s.Number("input_misfit_m"), s.Number("adjusted_misfit_m")});
+  }
+  return g;
+}
+
 AdjustmentRecord RecordOf(const Fields& f) {
   AdjustmentRecord r;
   r.usable = f.Get<bool>("usable");
@@ -212,6 +265,9 @@ AdjustmentRecord RecordOf(const Fields& f) {
                      c.Number("boresight_change_deg")});
   }
   r.model = ReadModel(f.Object("model"));
+  if (f.GetOr<json>("guard", json()).is_object()) {
+    r.guard = ReadGuard(f.Object("guard"));
+  }
   if (f.At("warnings").is_array()) {
     r.warnings = f.Get<std::vector<std::string>>("warnings");
   }
@@ -281,6 +337,7 @@ json AdjustmentJson(const AdjustmentRecord& r) {
   }
   j["rig"] = rig;
   j["model"] = ModelJson(r.model);
+  j["guard"] = GuardJson(r.guard);
   if (r.tie_points) {
     const AdjustmentRecord::TiePoints& t = *r.tie_points;
     j["tie_points"] = {

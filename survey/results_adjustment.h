@@ -117,6 +117,32 @@ struct AdjustmentRecord {
     double time_s = 0.0;
   };
   std::optional<TiePoints> tie_points;  // absent without tie points
+  // Never worse than the input (issue 43): every matched crossing placed
+  // with the input and with the adjusted trajectory, and the stretches
+  // where the input was kept because the adjusted trajectory fitted the
+  // matched crossings worse (times of the trajectory; the open end of a
+  // stretch reaching the survey's start or end is NaN, written null).
+  struct Guard {
+    struct Crossing {
+      std::string crossing_id;
+      bool used = true;  // control or check; false: rejected
+      double input_misfit_m = 0.0;
+      double adjusted_misfit_m = 0.0;
+      double z = 0.0;  // evidence that the adjusted is worse, in sd
+      bool worse = false;
+    };
+    struct Stretch {
+      double blend_begin_time_s = 0.0;
+      double begin_time_s = 0.0;
+      double end_time_s = 0.0;
+      double blend_end_time_s = 0.0;
+      std::vector<std::string> crossings;
+      double input_misfit_m = 0.0;
+      double adjusted_misfit_m = 0.0;
+    };
+    std::vector<Crossing> crossings;
+    std::vector<Stretch> input_kept;
+  } guard;
   std::vector<std::string> warnings;
 };
 

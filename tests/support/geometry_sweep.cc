@@ -157,10 +157,10 @@ void Dump(const SimulationOptions& options,
           const SyntheticReconstruction& reconstruction,
           const std::vector<ReconstructedLinePoint>* lines,
           const MatchResult& match, const AdjustmentResult& adjusted,
-          bool usable, const std::string& folder) {
+          bool usable, bool images, const std::string& folder) {
   namespace fs = std::filesystem;
   SimulationOptions render = options;
-  render.render_images = true;
+  render.render_images = images;
   SimulateSurvey(render, (fs::path(folder) / "survey").string(), {});
   const fs::path results = fs::path(folder) / "results";
   fs::create_directories(results);
@@ -257,6 +257,9 @@ std::string GeometryRunResult::Line() const {
       flags += " (" + std::to_string(wrong_on_cut_bands) + " on cut bands)";
     }
     for (const std::string& c : wrong_crossings) flags += " " + c;
+  }
+  if (input_kept_stretches > 0) {
+    flags += " INPUT-KEPT-x" + std::to_string(input_kept_stretches);
   }
   if (worse_position) flags += " WORSE-POSITION";
   if (worse_attitude) flags += " WORSE-ATTITUDE";
@@ -436,10 +439,10 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     AdjustmentOptions adjustment;
     adjustment.solver.num_threads = 1;
     adjustment.log_warnings = false;
-    if (!options.never_worse) {
+    if (!options.outage_readings) {
       adjustment.never_worse.outage_min_jump_m = 0.0;
-      adjustment.never_worse.guard_sigmas = 0.0;
     }
+    if (!options.guard) adjustment.never_worse.guard_sigmas = 0.0;
     AdjustmentData data =
         AdjustmentDataOf(survey, reconstruction.vertices, match.matches);
     std::vector<std::string> warnings;
@@ -466,6 +469,8 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
                  &result);
     result.usable = adjusted.summary.IsUsable();
     if (!result.usable) result.message = adjusted.summary.message;
+    result.input_kept_stretches =
+        static_cast<int>(adjusted.summary.kept_input.size());
     ScorePoses(simulated, survey, adjusted, &result);
     if (result.usable) {
       result.worse_position = std::hypot(result.h_after_m, result.v_after_m) >
@@ -477,7 +482,15 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     }
     if (!dump_folder.empty()) {
       Dump(simulation, reconstruction, lines, match, adjusted, result.usable,
-           dump_folder);
+           options.dump_images, dump_folder);
+      if (result.usable) {
+        // The adjustment's record, for `zebrageo report` on the dump.
+        WriteAdjustmentRecord(
+            AdjustmentRecordOf(data, adjustment, adjusted, nullptr),
+            (std::filesystem::path(dump_folder) / "results" /
+             kAdjustmentJsonFile)
+                .string());
+      }
     }
   } catch (const std::exception& e) {
     result.error = e.what();
@@ -534,6 +547,7 @@ GeometrySweepSummary Summarise(const std::vector<GeometryRunResult>& results) {
     s.repainted_matched += r.repainted_matched;
     s.worse_position += r.worse_position ? 1 : 0;
     s.worse_attitude += r.worse_attitude ? 1 : 0;
+    s.input_kept += r.input_kept_stretches > 0 ? 1 : 0;
     s.unusable += r.usable ? 0 : 1;
     s.unusable_with_control += r.UnusableWithControl() ? 1 : 0;
     std::array<int, 7>& kind = s.by_kind[r.kind];
@@ -610,7 +624,8 @@ std::string GeometrySweepSummary::Report() const {
       << repainted_matched << " of "
       << crossings_matchable - consistent_crossings << "\n"
       << "  worse than the input: position " << worse_position << ", attitude "
-      << worse_attitude << "\n"
+      << worse_attitude << "; the input kept somewhere by the guard in "
+      << input_kept << " surveys\n"
       << "  unusable adjustments (exit 3) " << unusable << ", of which "
       << unusable_with_control << " with a consistent set of crossings\n"
       << "  errors (exceptions) " << errors << "\n"

@@ -61,9 +61,13 @@ struct GeometrySweepOptions {
   // crossings only.
   bool lines = true;
   // The adjustment's "never worse than the input" (issue 43): its outage
-  // readings and its guard (AdjustmentOptions::never_worse). false: both
-  // off, the adjustment as before them.
-  bool never_worse = true;
+  // readings and its guard (AdjustmentOptions::never_worse). false: off,
+  // the adjustment as before them.
+  bool outage_readings = true;
+  bool guard = true;
+  // RunGeometrySurvey's dump renders the survey's images (false: geometry
+  // only, to look at the trajectories and matches).
+  bool dump_images = true;
 
   std::string Check() const;
 };
@@ -109,6 +113,8 @@ struct GeometryRunResult {
   double h_after_m = 0.0, v_after_m = 0.0, att_after_deg = 0.0;
   bool worse_position = false;
   bool worse_attitude = false;
+  // Stretches where the guard kept the input (control_guard.h).
+  int input_kept_stretches = 0;
   double seconds = 0.0;
 
   // "exit 3" while a consistent set of crossings exists.
@@ -150,6 +156,7 @@ struct GeometrySweepSummary {
   int repainted_matched = 0;  // repainted crossings kept as control
   int worse_position = 0;
   int worse_attitude = 0;
+  int input_kept = 0;  // surveys where the guard kept the input somewhere
   int unusable = 0;
   int unusable_with_control = 0;
   double seconds = 0.0;  // summed over surveys
