@@ -147,7 +147,11 @@ double CrabLogLikelihood(const Trajectory& trajectory,
     const double z = (crab[k] - centre) / sigma[k];
     log_likelihood -= 0.5 * z * z;
   }
-  return log_likelihood;
+  // The sigmas count the body's sway as independent over a second; the
+  // GNSS's drift and a jittery solution's wander stay correlated over
+  // several: the constraints within kCrabCorrelationS count as one.
+  constexpr double kCrabCorrelationS = 5.0;
+  return log_likelihood / kCrabCorrelationS;
 }
 
 }  // namespace
@@ -299,15 +303,8 @@ std::vector<std::string> ChooseOutageModel(Context* context,
       continue;
     }
     const double t_jump = TimeOf(trajectory, jump.first);
-    // Where the readings differ: from the previous jump to the next one.
+    // Where the readings' outage parts differ: from the previous jump on.
     const double window_begin = TimeOf(trajectory, floor);
-    double window_end = trajectory.end_time();
-    for (const JumpEvent& next : jumps) {
-      if (next.first > jump.last) {
-        window_end = TimeOf(trajectory, next.first);
-        break;
-      }
-    }
     const double jump_begin = TimeOf(trajectory, jump.first - 1);
     const double jump_end = TimeOf(trajectory, jump.last);
     // The readings, coarse first (the outage's length, the GNSS part's
@@ -327,8 +324,11 @@ std::vector<std::string> ChooseOutageModel(Context* context,
       ApplyOutageHypothesis(trajectory, jump, floor, hypotheses[k], &trial);
       SetKnotPriors(*context, trial, state);
       Score score = ScoreOf(*context, crossings, *state);
+      // The crab before the jump only: after it a reading's GNSS part
+      // decays over tens of seconds, as the GNSS's own slow drift does,
+      // which the crab cannot tell apart; an outage's drift is fast.
       score.log_likelihood +=
-          CrabLogLikelihood(trajectory, trial, *state, window_begin, window_end,
+          CrabLogLikelihood(trajectory, trial, *state, window_begin, jump_begin,
                             jump_begin, jump_end);
       VLOG(1) << "outage model, jump of " << J.norm() << " m at "
               << t_jump - trajectory.start_time()

@@ -15,7 +15,9 @@
 # (kept: a rerun renders only what is missing) and the results (redone);
 # MAX_ROAD_LENGTH (default 300 m) keeps the streets short: 30 surveys
 # render and run in about 30-60 minutes on 2 idle cores; ZEBRAGEO_THREADS
-# (default 2).
+# (default 2); SEEDS (e.g. "6 10 25") runs those seeds instead of N from
+# FIRST_SEED: the random preset's outage kind (issue 43) is seeds 6 10 25
+# 44 58 101 103 115 116 122 (with MAX_ROAD_LENGTH=700).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"
@@ -32,7 +34,8 @@ threads="${ZEBRAGEO_THREADS:-2}"
 mkdir -p "$work"
 scores="$work/scores.jsonl"
 : > "$scores"
-for ((seed = first; seed < first + n; ++seed)); do
+seeds="${SEEDS:-$(seq "$first" $((first + n - 1)))}"
+for seed in $seeds; do
   survey="$work/random-$seed"
   results="$work/random-$seed-results"
   if [[ ! -f "$survey/survey.yaml" ]]; then
