@@ -361,8 +361,8 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   }
   // Never worse than the input (issue 43): each matched crossing placed
   // with the input and with the adjusted trajectory.
-  const json guard = report.value("adjustment", json::object())
-                         .value("guard", json::object());
+  const json guard =
+      report.value("adjustment", json::object()).value("guard", json::object());
   if (!guard.value("crossings", json::array()).empty()) {
     html << "<h2>Compared with the input trajectory</h2>\n<p>"
          << (guard.value("input_kept", false)
