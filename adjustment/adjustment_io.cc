@@ -87,7 +87,7 @@ AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
     const Eigen::AngleAxisd change(
         data.rig.cameras[c].T_body_cam.linear().transpose() * T.linear());
     r.rig.push_back({data.rig.cameras[c].camera.name(), T.translation(),
-                     change.angle() * 180.0 / M_PI});
+                     RadToDeg(change.angle())});
   }
   AdjustmentRecord::Model& m = r.model;
   m.knot_spacing_s = options.knot_spacing_s;

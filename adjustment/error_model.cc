@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
@@ -35,8 +37,7 @@ double LogLikelihood(const ProcessSamples& s, double sigma, double tau_s) {
   const Eigen::VectorXd w = llt.matrixL().solve(y);
   double log_det = 0.0;
   for (int i = 0; i < n; ++i) log_det += 2.0 * std::log(llt.matrixL()(i, i));
-  return -0.5 * w.squaredNorm() - 0.5 * log_det -
-         0.5 * n * std::log(2.0 * 3.14159265358979323846);
+  return -0.5 * w.squaredNorm() - 0.5 * log_det - 0.5 * n * std::log(2.0 * kPi);
 }
 
 // The sigma in [min, max] of the largest likelihood at `tau_s`: golden

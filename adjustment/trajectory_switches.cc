@@ -5,14 +5,10 @@
 #include <deque>
 #include <limits>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
-
-double Median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2,
-                   values.end());
-  return values[values.size() / 2];
-}
 
 // The mean of `track` over the samples within +-half_window_s of each.
 std::vector<double> SmoothedTrack(const std::vector<double>& track,

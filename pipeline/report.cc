@@ -22,7 +22,6 @@
 
 namespace zebrageo {
 using report_internal::Collect;
-using report_internal::kRadToDeg;
 using report_internal::RenderHtml;
 using report_internal::ReportData;
 

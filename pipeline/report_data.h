@@ -16,8 +16,6 @@
 namespace zebrageo {
 namespace report_internal {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
-
 // Everything the report shows, gathered once from the results folder.
 struct ReportData {
   // Trajectory: input and corrected, sample by sample.

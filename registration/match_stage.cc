@@ -16,6 +16,7 @@
 #include "registration/paint_probe.h"
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 #include "survey/results_adjustment.h"
 
 namespace zebrageo {
@@ -23,8 +24,6 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // Rounded for a person; positions keep full precision.
 double Round(double value, double unit) {
@@ -225,7 +224,7 @@ void WriteMatchEvidence(const MatchResult& result, const MatchOptions& options,
       o["correction"] = {
           {"de_m", Round(e.correction.shift_enu_m.x(), 1e-4)},
           {"dn_m", Round(e.correction.shift_enu_m.y(), 1e-4)},
-          {"dheading_deg", Round(e.correction.heading_rad * kRadToDeg, 1e-4)}};
+          {"dheading_deg", Round(RadToDeg(e.correction.heading_rad), 1e-4)}};
     }
     if (e.decision == Decision::kMatched) {
       o["matched_bands"] = e.matched_bands;

@@ -17,6 +17,7 @@
 #include "survey/input_error.h"
 #include "survey/json_file.h"
 #include "survey/results.h"
+#include "survey/text_file.h"
 
 namespace zebrageo {
 namespace {
@@ -26,13 +27,6 @@ namespace fs = std::filesystem;
 constexpr char kCrsColumns[] = "crs_x,crs_y,crs_z";
 constexpr char kCrsCommentPrefix[] = "# output_crs";
 constexpr char kCrsColumnsComment[] = "# crs_x,crs_y,crs_z:";
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 std::vector<std::string> SplitLines(const std::string& text) {
   std::vector<std::string> lines;
@@ -97,7 +91,7 @@ struct CrsWriter {
       const std::string& path, const std::string& display_name,
       const std::vector<std::string>& required,
       const std::function<Geodetic(const CsvTable&, int)>& position) const {
-    const std::string text = ReadText(path);
+    const std::string text = ReadTextFile(path, display_name);
     const CsvTable table = CsvTable::Parse(text, display_name, required);
     std::vector<std::string> lines = SplitLines(text);
     const int kept_fields = table.ColumnIndex("crs_x");

@@ -18,7 +18,6 @@
 namespace zebrageo {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / kPi;
 // Gaps listed one by one in the warnings before "and N more".
 constexpr int kMaxListedGaps = 3;
 
@@ -68,13 +67,6 @@ double WrapPi(double angle) {
   double wrapped = std::remainder(angle, 2.0 * kPi);
   if (wrapped <= -kPi) wrapped += 2.0 * kPi;
   return wrapped;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2,
-                   values.end());
-  return values[values.size() / 2];
 }
 
 // Up to `count` samples spread evenly over the trajectory (distance
@@ -133,9 +125,9 @@ HeadingDisagreement MeasureHeadingDisagreement(
     // The numbers of the file taken as radians: the attitude was divided by
     // 180 / pi when read.
     const TrajectorySample& s = samples[(i + j) / 2];
-    const Attitude radians{s.attitude.roll * kRadToDeg,
-                           s.attitude.pitch * kRadToDeg,
-                           s.attitude.heading * kRadToDeg};
+    const Attitude radians{RadToDeg(s.attitude.roll),
+                           RadToDeg(s.attitude.pitch),
+                           RadToDeg(s.attitude.heading)};
     as_radians.push_back(std::abs(WrapPi(
         course - ForwardYaw(frame.RotationEnuFromBody(s.position, radians)))));
     if (result.first_line == 0) result.first_line = samples[i].line;
@@ -154,7 +146,7 @@ HeadingDisagreement MeasureHeadingDisagreement(
 // a swap that brings two files together could then be in either.
 std::optional<bool> TrajectoryLooksSwapped(const Trajectory& trajectory,
                                            const PlausibilityOptions& options) {
-  const double limit_rad = options.max_heading_disagreement_deg / kRadToDeg;
+  const double limit_rad = DegToRad(options.max_heading_disagreement_deg);
   auto follows_heading =
       [&](const std::vector<TrajectorySample>& samples) -> std::optional<bool> {
     const LocalFrame frame(samples.front().position);
@@ -189,7 +181,7 @@ void CheckHeading(const PlausibilityInput& input,
                "of travel";
     return;
   }
-  const double limit_rad = options.max_heading_disagreement_deg / kRadToDeg;
+  const double limit_rad = DegToRad(options.max_heading_disagreement_deg);
   if (d.median_as_degrees_rad <= limit_rad) return;
   const std::string where =
       " (median over " + std::to_string(d.chords) + " stretches of " +
@@ -201,14 +193,14 @@ void CheckHeading(const PlausibilityInput& input,
         "columns 'roll', 'pitch', 'heading' look like radians, not degrees: "
         "read as degrees, the heading differs from the direction of travel "
         "by " +
-            Fixed(d.median_as_degrees_rad * kRadToDeg, 1) +
+            Fixed(RadToDeg(d.median_as_degrees_rad), 1) +
             " deg, read as radians by " +
-            Fixed(d.median_as_radians_rad * kRadToDeg, 1) + " deg" + where);
+            Fixed(RadToDeg(d.median_as_radians_rad), 1) + " deg" + where);
   }
   throw InputError(
       file, 0,
       "column 'heading' differs from the direction of travel by " +
-          Fixed(d.median_as_degrees_rad * kRadToDeg, 1) + " deg" + where +
+          Fixed(RadToDeg(d.median_as_degrees_rad), 1) + " deg" + where +
           ", more than max_heading_disagreement_deg = " +
           FormatDouble(options.max_heading_disagreement_deg) +
           ": the heading must be degrees clockwise from true north of the "

@@ -7,21 +7,12 @@
 #include "survey/geojson_internal.h"
 #include "survey/input_error.h"
 #include "survey/results.h"
+#include "survey/text_file.h"
 
 namespace zebrageo {
 namespace {
 
 using nlohmann::json;
-
-std::string ReadWholeFile(const std::string& path,
-                          const std::string& display_name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(display_name, 0, "cannot read " + path);
-  return text.str();
-}
 
 }  // namespace
 
@@ -57,7 +48,7 @@ void WriteAdjustedBands(const std::vector<AdjustedBand>& bands,
 
 std::vector<AdjustedBand> ReadAdjustedBands(const std::string& path,
                                             const std::string& display_name) {
-  const std::string text = ReadWholeFile(path, display_name);
+  const std::string text = ReadTextFile(path, display_name);
   const json root = geojson_internal::ParseJson(text, display_name);
   if (!root.is_object() || !root.contains("type") ||
       root["type"] != "FeatureCollection" || !root.contains("features") ||

@@ -12,6 +12,7 @@
 
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
@@ -98,7 +99,7 @@ double RoadHeightBelow(const std::vector<TrajectorySample>& trajectory,
                        double lat_deg, double lon_deg) {
   double best = std::numeric_limits<double>::infinity();
   double height = 0.0;
-  const double scale = std::cos(lat_deg * 3.14159265358979323846 / 180.0);
+  const double scale = std::cos(DegToRad(lat_deg));
   for (const TrajectorySample& s : trajectory) {
     const double dlat = s.position.lat_deg - lat_deg;
     const double dlon = (s.position.lon_deg - lon_deg) * scale;
