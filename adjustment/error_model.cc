@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -93,24 +94,17 @@ ProcessSamples ProcessSamples::Without(int i) const {
 }
 
 std::string GaussMarkovFitOptions::Check() const {
-  std::ostringstream out;
-  if (!(min_sigma > 0.0) || !(max_sigma >= min_sigma) ||
-      !std::isfinite(max_sigma)) {
-    out << "min_sigma = " << min_sigma << ", max_sigma = " << max_sigma
-        << ": need 0 < min_sigma <= max_sigma";
-  } else if (!(default_tau_s > 0.0) || !std::isfinite(default_tau_s)) {
-    out << "default_tau_s = " << default_tau_s << ": must be > 0";
-  } else if (tau_grid_s.empty()) {
-    out << "tau_grid_s: must not be empty";
-  } else {
-    for (double tau : tau_grid_s) {
-      if (!(tau > 0.0) || !std::isfinite(tau)) {
-        out << "tau_grid_s holds " << tau << ": every tau must be > 0";
-        break;
-      }
-    }
+  OptionCheck check;
+  OPTION_GT(check, min_sigma, 0.0);
+  OPTION_GE(check, max_sigma, min_sigma);
+  OPTION_GT(check, default_tau_s, 0.0);
+  check.Require(!tau_grid_s.empty(), "tau_grid_s", std::string("[]"),
+                "must not be empty");
+  for (double tau : tau_grid_s) {
+    check.Require(tau > 0.0 && std::isfinite(tau), "tau_grid_s[]", tau,
+                  "every tau must be > 0");
   }
-  return out.str();
+  return check.problem();
 }
 
 GaussMarkovFit FitGaussMarkov(const ProcessSamples& samples,

@@ -17,6 +17,7 @@
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
 #include "survey/results.h"
+#include "survey/option_check.h"
 #include "survey/results_adjustment.h"
 #include "tools/version.h"
 
@@ -394,18 +395,11 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
 }  // namespace
 
 std::string ReportOptions::Check() const {
-  if (!(max_uncontrolled_stretch_m > 0.0)) {
-    return "max_uncontrolled_stretch_m = " +
-           std::to_string(max_uncontrolled_stretch_m) + ": must be > 0";
-  }
-  if (!(control_radius_m > 0.0)) {
-    return "control_radius_m = " + std::to_string(control_radius_m) +
-           ": must be > 0";
-  }
-  if (!(max_sigma0 > 0.0)) {
-    return "max_sigma0 = " + std::to_string(max_sigma0) + ": must be > 0";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GT(check, max_uncontrolled_stretch_m, 0.0);
+  OPTION_GT(check, control_radius_m, 0.0);
+  OPTION_GT(check, max_sigma0, 0.0);
+  return check.problem();
 }
 
 json BuildReport(const ReportInputs& inputs, const ReportOptions& options) {

@@ -15,6 +15,7 @@
 #include "reconstruction/debug_images.h"
 #include "survey/image_io.h"
 #include "survey/input_error.h"
+#include "survey/option_check.h"
 #include "survey/threads.h"
 
 namespace zebrageo {
@@ -84,18 +85,18 @@ std::vector<EdgeChain3d> ChainsNearRoad(
 }  // namespace
 
 std::string ReconstructionOptions::Check() const {
-  for (const std::string& error :
-       {rectification.Check(), edges.Check(), matching.Check(), search.Check(),
-        road_plane.Check(), zebra.Check(), long_sides.Check(), bands.Check()}) {
-    if (!error.empty()) return error;
-  }
-  std::ostringstream error;
-  if (threads < 0) {
-    error << "threads = " << threads << ": must be >= 0";
-  } else if (batch_exposures < 1) {
-    error << "batch_exposures = " << batch_exposures << ": must be >= 1";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_NESTED(check, rectification);
+  OPTION_NESTED(check, edges);
+  OPTION_NESTED(check, matching);
+  OPTION_NESTED(check, search);
+  OPTION_NESTED(check, road_plane);
+  OPTION_NESTED(check, zebra);
+  OPTION_NESTED(check, long_sides);
+  OPTION_NESTED(check, bands);
+  OPTION_GE(check, threads, 0);
+  OPTION_GE(check, batch_exposures, 1);
+  return check.problem();
 }
 
 double StepTimings::Total() const {

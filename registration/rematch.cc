@@ -17,6 +17,7 @@
 #include "registration/match_stage.h"
 #include "registration/paint_probe.h"
 #include "survey/input_error.h"
+#include "survey/option_check.h"
 #include "survey/results_adjustment.h"
 
 namespace zebrageo {
@@ -24,54 +25,20 @@ namespace zebrageo {
 namespace fs = std::filesystem;
 
 std::string RematchOptions::Check() const {
-  if (min_control_crossings < 1) {
-    return "min_control_crossings = " + std::to_string(min_control_crossings) +
-           ": must be >= 1";
-  }
-  if (min_hit_bands < 1) {
-    return "min_hit_bands = " + std::to_string(min_hit_bands) +
-           ": must be >= 1";
-  }
-  if (!(gate_m > 0.0) || !std::isfinite(gate_m)) {
-    return "gate_m = " + std::to_string(gate_m) + ": must be finite and > 0";
-  }
-  if (!(cross_track_gate_m > 0.0) || !(cross_track_gate_m < 0.5)) {
-    // Half a band period: beyond it a wrong band offset can be nearer.
-    return "cross_track_gate_m = " + std::to_string(cross_track_gate_m) +
-           ": must be in (0, 0.5)";
-  }
-  if (!(max_line_control_gap_m >= 0.0) ||
-      !std::isfinite(max_line_control_gap_m)) {
-    return "max_line_control_gap_m = " +
-           std::to_string(max_line_control_gap_m) + ": must be finite and >= 0";
-  }
-  if (!(max_cross_track_control_gap_m >= 0.0) ||
-      !std::isfinite(max_cross_track_control_gap_m)) {
-    return "max_cross_track_control_gap_m = " +
-           std::to_string(max_cross_track_control_gap_m) +
-           ": must be finite and >= 0";
-  }
-  if (!(max_sideways_m >= 0.0) || !(max_sideways_m < 0.5)) {
-    return "max_sideways_m = " + std::to_string(max_sideways_m) +
-           ": must be in [0, 0.5)";
-  }
-  if (!(max_line_drift_sd_m >= 0.0) || !std::isfinite(max_line_drift_sd_m)) {
-    return "max_line_drift_sd_m = " + std::to_string(max_line_drift_sd_m) +
-           ": must be finite and >= 0";
-  }
-  if (!(max_line_bracket_gap_s >= 0.0)) {
-    return "max_line_bracket_gap_s = " +
-           std::to_string(max_line_bracket_gap_s) + ": must be >= 0";
-  }
-  if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
-    return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
-           ": must be finite and > 0";
-  }
-  if (!(max_heading_error_rad > 0.0) || !(max_heading_error_rad < 0.5)) {
-    return "max_heading_error_rad = " + std::to_string(max_heading_error_rad) +
-           ": must be in (0, 0.5)";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GE(check, min_control_crossings, 1);
+  OPTION_GE(check, min_hit_bands, 1);
+  OPTION_GT(check, gate_m, 0.0);
+  // Half a band period: beyond it a wrong band offset can be nearer.
+  OPTION_IN(check, cross_track_gate_m, "(", 0.0, 0.5, ")");
+  OPTION_GE(check, max_line_control_gap_m, 0.0);
+  OPTION_GE(check, max_cross_track_control_gap_m, 0.0);
+  OPTION_IN(check, max_sideways_m, "[", 0.0, 0.5, ")");
+  OPTION_GE(check, max_line_drift_sd_m, 0.0);
+  OPTION_GE(check, max_line_bracket_gap_s, 0.0);
+  OPTION_GT(check, sd_gate_factor, 0.0);
+  OPTION_IN(check, max_heading_error_rad, "(", 0.0, 0.5, ")");
+  return check.problem();
 }
 
 namespace {

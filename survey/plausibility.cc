@@ -14,6 +14,7 @@
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -492,28 +493,17 @@ void CheckGaps(const PlausibilityInput& input,
 }  // namespace
 
 std::string PlausibilityOptions::Check() const {
-  const std::string gap_problem = gaps.Check();
-  if (!gap_problem.empty()) return "gaps." + gap_problem;
-  const std::pair<const char*, double> positive[] = {
-      {"max_exposure_gap_s", max_exposure_gap_s},
-      {"min_rate_hz", min_rate_hz},
-      {"heading_chord_s", heading_chord_s},
-      {"max_heading_disagreement_deg", max_heading_disagreement_deg},
-      {"max_origin_distance_m", max_origin_distance_m},
-      {"max_database_distance_m", max_database_distance_m}};
-  for (const auto& [name, value] : positive) {
-    if (!(value > 0.0)) {
-      return std::string(name) + " = " + FormatDouble(value) + ": must be > 0";
-    }
-  }
-  if (!(min_speed_mps >= 0.0)) {
-    return "min_speed_mps = " + FormatDouble(min_speed_mps) + ": must be >= 0";
-  }
-  if (min_heading_chords < 1) {
-    return "min_heading_chords = " + std::to_string(min_heading_chords) +
-           ": must be >= 1";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_NESTED(check, gaps);
+  OPTION_GT(check, max_exposure_gap_s, 0.0);
+  OPTION_GT(check, min_rate_hz, 0.0);
+  OPTION_GT(check, heading_chord_s, 0.0);
+  OPTION_GT(check, max_heading_disagreement_deg, 0.0);
+  OPTION_GT(check, max_origin_distance_m, 0.0);
+  OPTION_GT(check, max_database_distance_m, 0.0);
+  OPTION_GE(check, min_speed_mps, 0.0);
+  OPTION_GE(check, min_heading_chords, 1);
+  return check.problem();
 }
 
 std::vector<std::string> CheckPlausibility(const PlausibilityInput& input,

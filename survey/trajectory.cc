@@ -10,6 +10,7 @@
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -162,14 +163,10 @@ bool Trajectory::InterpolatePose(double time, Pose* pose) const {
 }
 
 std::string TrajectoryGapOptions::Check() const {
-  if (!(factor > 1.0)) {
-    return "factor = " + FormatDouble(factor) + ": must be > 1";
-  }
-  if (!(min_duration_s >= 0.0)) {
-    return "min_duration_s = " + FormatDouble(min_duration_s) +
-           ": must be >= 0";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GT(check, factor, 1.0);
+  OPTION_GE(check, min_duration_s, 0.0);
+  return check.problem();
 }
 
 double MedianSampleInterval(const std::vector<double>& times) {
