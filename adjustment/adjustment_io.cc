@@ -90,8 +90,8 @@ AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
                      RadToDeg(change.angle())});
   }
   AdjustmentRecord::Model& m = r.model;
-  m.knot_spacing_s = options.knot_spacing_s;
-  m.position_model_estimated = options.estimate_position_model;
+  m.knot_spacing_s = options.model.knot_spacing_s;
+  m.position_model_estimated = options.model.estimate_position_model;
   // Along-track, cross-track, up.
   m.position_sigma_m = s.position_sigma_m;
   m.position_tau_s = s.position_tau_s;
@@ -101,11 +101,11 @@ AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
   m.vehicle_motion_sigma_deg = Eigen::Vector2d(
       RadToDeg(s.motion_sigma_rad.x()), RadToDeg(s.motion_sigma_rad.y()));
   m.tie_sigma_px = s.tie_sigma_px;
-  m.vertex_sigma_px = options.vertex_sigma_px;
-  m.crossing_offset_sigma_m = options.crossing_offset_sigma_m;
-  m.check_crossing_share = options.check_crossing_share;
-  m.blunder_threshold = options.blunder_threshold;
-  m.self_calibrate_rig = options.self_calibrate_rig;
+  m.vertex_sigma_px = options.control.vertex_sigma_px;
+  m.crossing_offset_sigma_m = options.control.crossing_offset_sigma_m;
+  m.check_crossing_share = options.control.check_crossing_share;
+  m.blunder_threshold = options.blunders.blunder_threshold;
+  m.self_calibrate_rig = options.rig_calibration.self_calibrate_rig;
   if (ties != nullptr) {
     r.tie_points = AdjustmentRecord::TiePoints{
         ties->images_read, ties->images_missing, ties->matches,

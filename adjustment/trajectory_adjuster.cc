@@ -126,8 +126,9 @@ AdjustmentResult AdjustTrajectory(
   // The INS trajectory the correction applies to: without its jumps.
   Context context{
       options, input,
-      RemoveJumps(*input.trajectory, options.jump_threshold_m,
-                  options.jump_threshold_rad, options.sideways_switches),
+      RemoveJumps(*input.trajectory, options.trajectory_faults.jump_threshold_m,
+                  options.trajectory_faults.jump_threshold_rad,
+                  options.trajectory_faults.sideways_switches),
       &summary};
   summary.num_jumps = context.dejumped.num_jumps;
   for (const SidewaysSwitch& s : context.dejumped.switches) {

@@ -206,7 +206,7 @@ std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
     const std::vector<ReconstructedLinePoint>* line_points,
     const AdjustmentOptions& user_options) {
   if (line_points == nullptr || line_points->empty() ||
-      !user_options.line_control_without_crossings) {
+      !user_options.road_lines.line_control_without_crossings) {
     return std::nullopt;
   }
   AdjustmentOptions options = user_options;

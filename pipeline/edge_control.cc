@@ -126,7 +126,7 @@ int AddCrossingEdgeControl(
     // The database's error is the crossing's, shared by every point on
     // the edge: counted once over them.
     const double db_sigma =
-        std::max(db.sigma_xy_m, options.min_database_sigma_m);
+        std::max(db.sigma_xy_m, options.control.min_database_sigma_m);
     const double shared_variance = points_on[m.db_edge] * db_sigma * db_sigma;
     const Eigen::Matrix3d R = pose_of[m.edge].q_enu_body.toRotationMatrix();
     for (size_t k = 0; k < edge_points[m.edge].size(); ++k) {

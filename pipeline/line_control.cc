@@ -177,8 +177,8 @@ LineControlPoint ControlPointOf(const ReconstructedLinePoint& p, double time,
       DatabaseLineGrade(line, m.db_segment, m.db_segment_t, kGradeHalfWindowM);
   c.sqrt_information = LineSqrtInformation(
       p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
-      shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),
-      shared * std::max(line.sigma_z_m, options.min_database_sigma_m));
+      shared * std::max(line.sigma_xy_m, options.control.min_database_sigma_m),
+      shared * std::max(line.sigma_z_m, options.control.min_database_sigma_m));
   // Across the line is cross-track when the line runs with the vehicle.
   const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
   *cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
@@ -283,7 +283,7 @@ int AddDashControl(const std::vector<ReconstructedLinePoint>& points,
     // The database dash's error is shared by every exposure that saw it.
     const double db_sigma =
         std::sqrt(static_cast<double>(seen_of_db_dash[m.db_line])) *
-        std::max(line.sigma_xy_m, options.min_database_sigma_m);
+        std::max(line.sigma_xy_m, options.control.min_database_sigma_m);
     const Eigen::Matrix3d R = pose.q_enu_body.toRotationMatrix();
     const Eigen::Matrix3d covariance_enu =
         R * (0.25 * (a.covariance_body + b.covariance_body)) * R.transpose();

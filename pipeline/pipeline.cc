@@ -243,8 +243,8 @@ RunSummary RunSurveyPipeline(const Survey& survey,
                     }});
   std::ostringstream settings;
   settings << "threads-independent;ties=" << options.tie_points
-           << ";lines=" << options.lines
-           << ";sideslip=" << RadToDeg(options.adjustment.sideslip_sigma_rad)
+           << ";lines=" << options.lines << ";sideslip="
+           << RadToDeg(options.adjustment.vehicle_motion.sideslip_sigma_rad)
            << ";rematch=" << options.rematch;
   const PipelineRun run =
       RunPipeline(results_folder,

@@ -19,17 +19,18 @@ struct AdjustArguments {
   bool tie_points = true;
   bool lines = true;
   bool self_calibrate = false;
-  double check_share = AdjustmentOptions().check_crossing_share;
+  double check_share = AdjustmentOptions().control.check_crossing_share;
   int threads = AdjustmentOptions().solver.num_threads;
-  double sideslip_sigma_deg = RadToDeg(AdjustmentOptions().sideslip_sigma_rad);
+  double sideslip_sigma_deg =
+      RadToDeg(AdjustmentOptions().vehicle_motion.sideslip_sigma_rad);
 };
 
 void RunAdjust(const AdjustArguments& args) {
   AdjustmentOptions options;
-  options.check_crossing_share = args.check_share;
-  options.self_calibrate_rig = args.self_calibrate;
+  options.control.check_crossing_share = args.check_share;
+  options.rig_calibration.self_calibrate_rig = args.self_calibrate;
   options.solver.num_threads = args.threads;
-  options.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
+  options.vehicle_motion.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
   ResultsSession session(args.stage.results,

@@ -24,7 +24,8 @@ struct RunArguments {
   int threads = 0;
   bool tie_points = true;
   bool lines = true;  // road lines as control beside the zebras (issue 9)
-  double sideslip_sigma_deg = RadToDeg(AdjustmentOptions().sideslip_sigma_rad);
+  double sideslip_sigma_deg =
+      RadToDeg(AdjustmentOptions().vehicle_motion.sideslip_sigma_rad);
   // Second registration pass with the adjusted trajectory.
   bool rematch = true;
 };
@@ -46,7 +47,8 @@ void Run(const RunArguments& args) {
   options.threads = args.threads;
   options.reconstruction.threads = args.threads;
   if (args.threads > 0) options.adjustment.solver.num_threads = args.threads;
-  options.adjustment.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
+  options.adjustment.vehicle_motion.sideslip_sigma_rad =
+      DegToRad(args.sideslip_sigma_deg);
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError(problem);
   session.Open();

@@ -287,8 +287,8 @@ TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
     band.sigma_xy_m = 0.05;
     band.sigma_z_m = 0.1;
     const double n0 = 2.0 - b, n1 = n0 + 0.5;
-    const Eigen::Vector3d corners[4] = {{100, n0, 0}, {103, n0, 0},
-                                        {103, n1, 0}, {100, n1, 0}};
+    const Eigen::Vector3d corners[4] = {
+        {100, n0, 0}, {103, n0, 0}, {103, n1, 0}, {100, n1, 0}};
     for (int k = 0; k < 4; ++k) {
       band.corners[k] = data_.frame.GeodeticFromEnu(corners[k]);
     }

@@ -159,7 +159,7 @@ TEST_F(RoadLinesAdjustmentTest, NothingWithoutLinePointsOrWhenTurnedOff) {
   EXPECT_FALSE(
       AdjustByRoadLinesAlone(data_, &none, AdjustmentOptions()).has_value());
   AdjustmentOptions off;
-  off.line_control_without_crossings = false;
+  off.road_lines.line_control_without_crossings = false;
   EXPECT_FALSE(AdjustByRoadLinesAlone(data_, &points_, off).has_value());
   // A database without lines: nothing to correct with.
   data_.roadmarks.lines.clear();
