@@ -7,8 +7,8 @@ and compares the two results folders file by file: every file of either
 folder must be in the other; numbers equal to 1e-9 (relative above 1),
 everything else as text. Timings are left out: JSON members named as in
 TIMING_KEYS, and in text "<number> s" / "<number> ms" (the comment lines of
-the CSVs, the brief reports, report.html). run_state.json's fingerprint
-names the binary, so it is left out too.
+the CSVs, the brief reports, report.html), and run_state.json (the
+resume's bookkeeping, whose fingerprints name the binary).
 
 Usage:
   bench/results_identity.py BASELINE CANDIDATE [--work DIR] [--only NAME...]
@@ -51,13 +51,16 @@ SIMULATED = {
 TIMING_KEYS = {"timings_s", "seconds", "time_s", "time_in_seconds",
                "wall_time_s", "elapsed_s", "peak_memory_mb", "fingerprint",
                "stage_fingerprints"}
-IGNORED_FILES = {".zebrageo.lock"}
+# The lock holds a pid; run_state.json is the resume's bookkeeping (which
+# stages ran, their fingerprints), not a result.
+IGNORED_FILES = {".zebrageo.lock", "run_state.json"}
 NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 TIMING = re.compile(r"[-+]?\d+(\.\d+)?(e[-+]?\d+)?\s?m?s\b")
 # report.html's tables of timings (stage: seconds) and peak memory.
 HTML_TIMING = re.compile(
     r"(<th>(reconstruct|match|adjust|report|total|seconds|[a-z_ ]*time_s|"
     r"peak_memory_mb)</th><td>)[-+0-9.e]*(</td>)")
+PEAK_MEMORY = re.compile(r"Peak memory: [0-9.]+ MB")
 SPLIT = re.compile(r"([\s,;:\[\]{}()\"=<>/]+)")
 
 
@@ -75,6 +78,7 @@ def tokens_equal(a, b):
 
 def compare_text(text_a, text_b, name, problems):
     def masked(text):
+        text = PEAK_MEMORY.sub("Peak memory: <m> MB", text)
         return TIMING.sub("<t>", HTML_TIMING.sub(r"\1<t>\3", text))
 
     lines_a = masked(text_a).splitlines()
