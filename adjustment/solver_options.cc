@@ -31,15 +31,8 @@ std::string SolverOptions::Check() const {
 }
 
 const char* LinearSolverName(LinearSolver solver) {
-  switch (solver) {
-    case LinearSolver::kAuto:
-      return "auto";
-    case LinearSolver::kDenseSchur:
-      return "DENSE_SCHUR";
-    case LinearSolver::kSparseSchur:
-      return "SPARSE_SCHUR";
-    case LinearSolver::kIterativeSchur:
-      return "ITERATIVE_SCHUR";
+  for (const auto& [value, name] : kLinearSolverNames) {
+    if (value == solver) return name;
   }
   return "?";
 }

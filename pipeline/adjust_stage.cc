@@ -85,6 +85,7 @@ std::vector<double> FittedCrossTrackTimes(
 AdjustmentResult AdjustWithRoadLines(
     const AdjustmentData& data, AdjustmentInput input,
     const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration,
     const std::vector<ReconstructedLinePoint>* line_points,
     const std::string& results_folder, std::vector<std::string>* warnings,
     const ProgressListener& progress, std::vector<double>* line_control_times,
@@ -95,8 +96,9 @@ AdjustmentResult AdjustWithRoadLines(
   AdjustmentResult result = AdjustTrajectory(options, input, step.Callback());
   step.Finish();
   if (line_points == nullptr || !result.summary.IsUsable()) return result;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data, options, result, line_points, results_folder, warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data, options, registration, result, line_points,
+                              results_folder, warnings);
   if (control.empty()) return result;
   if (line_control_times != nullptr) {
     *line_control_times = CrossTrackTimes(control);
@@ -114,11 +116,11 @@ AdjustmentResult AdjustWithRoadLines(
 
 bool SecondPassOnRoadLines(const AdjustmentRecord& record,
                            const std::vector<CrossingDecision>& decisions,
-                           bool lines) {
+                           bool lines, const RematchOptions& rematch) {
   if (!lines || record.road_lines_only) return false;
   const int crossings =
       record.counts.control_crossings + record.counts.check_crossings;
-  if (crossings >= RematchOptions().min_control_crossings) return false;
+  if (crossings >= rematch.min_control_crossings) return false;
   for (const CrossingDecision& d : decisions) {
     if (d.decision != Decision::kMatched) return true;
   }
@@ -126,10 +128,10 @@ bool SecondPassOnRoadLines(const AdjustmentRecord& record,
 }
 
 std::vector<std::string> RunAdjustStage(
-    const Survey& survey, StageResults* results,
-    const AdjustmentOptions& options, bool tie_points, bool lines,
+    const Survey& survey, StageResults* results, const RunOptions& run,
     const ProgressListener& progress, std::vector<double>* line_control_times,
     std::vector<double>* fitted_line_times) {
+  const AdjustmentOptions& options = run.adjustment;
   const std::string& results_folder = results->folder();
   // The survey as loaded (not read again), with the stages' outputs.
   AdjustmentData data =
@@ -145,13 +147,13 @@ std::vector<std::string> RunAdjustStage(
   std::vector<TieTrack> tracks;
   TiePointSummary tie_summary;
   const bool use_ties =
-      tie_points &&
+      run.tie_points &&
       data.missing_images < static_cast<int>(data.exposures.images.size());
   if (use_ties) {
     StepProgress step(progress, "tie points");
-    tracks = BuildTieTracks(TiePointOptions(), data.survey_folder, data.rig,
-                            data.trajectory, data.exposures, &tie_summary,
-                            step.Callback());
+    tracks = BuildTieTracks(run.tie_point_matching, data.survey_folder,
+                            data.rig, data.trajectory, data.exposures,
+                            &tie_summary, step.Callback());
     step.Finish();
   }
   AdjustmentInput input = data.Input();
@@ -159,9 +161,9 @@ std::vector<std::string> RunAdjustStage(
 
   std::vector<std::string> warnings = data.warnings;
   AdjustmentResult result = AdjustWithRoadLines(
-      data, input, options, lines ? results->LinePoints() : nullptr,
-      results_folder, &warnings, progress, line_control_times,
-      fitted_line_times);
+      data, input, options, run.line_registration,
+      run.lines ? results->LinePoints() : nullptr, results_folder, &warnings,
+      progress, line_control_times, fitted_line_times);
   if (!result.summary.IsUsable()) {
     // A solver's message ("Ceres failed: ...") names no input: the survey's
     // warnings (gaps, rates, with their lines and times) may.
@@ -204,7 +206,8 @@ std::vector<std::string> RunAdjustStage(
 std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
     const AdjustmentData& data,
     const std::vector<ReconstructedLinePoint>* line_points,
-    const AdjustmentOptions& user_options) {
+    const AdjustmentOptions& user_options,
+    const LineRegistrationOptions& registration) {
   if (line_points == nullptr || line_points->empty() ||
       !user_options.road_lines.line_control_without_crossings) {
     return std::nullopt;
@@ -219,8 +222,8 @@ std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
   std::vector<std::string> warnings;
   RoadLinesAdjustment out;
   AdjustmentResult result =
-      AdjustWithRoadLines(data, input, options, line_points, "", &warnings,
-                          nullptr, &out.line_control_times);
+      AdjustWithRoadLines(data, input, options, registration, line_points, "",
+                          &warnings, nullptr, &out.line_control_times);
   if (!result.summary.IsUsable() || !result.summary.line_control_only) {
     return std::nullopt;
   }

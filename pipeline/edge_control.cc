@@ -58,6 +58,7 @@ std::set<std::string> CrossingsSeenWhole(
 
 int AddCrossingEdgeControl(
     const AdjustmentData& data, const AdjustmentOptions& options,
+    const CrossingEdgeMatchOptions& match_options,
     const AdjustmentResult& zebra_result,
     const std::vector<ReconstructedLinePoint>& points,
     const std::unordered_map<int64_t, double>& exposure_time,
@@ -92,7 +93,6 @@ int AddCrossingEdgeControl(
     pose_of.push_back(pose);
     time_of.push_back(t->second);
   }
-  CrossingEdgeMatchOptions match_options;
   std::vector<CrossingEdgeMatch> matches;
   // With zebra control the gate follows the corrected trajectory's sd.
   for (size_t e = 0; e < edges_enu.size(); ++e) {

@@ -11,6 +11,7 @@
 
 #include "adjustment/adjustment_io.h"
 #include "adjustment/line_control.h"
+#include "registration/edge_matcher.h"
 #include "survey/results_lines.h"
 
 namespace zebrageo {
@@ -32,6 +33,7 @@ double PosteriorSdAt(const AdjustmentResult& result, double time);
 // Returns how many control points were added.
 int AddCrossingEdgeControl(
     const AdjustmentData& data, const AdjustmentOptions& options,
+    const CrossingEdgeMatchOptions& match_options,
     const AdjustmentResult& zebra_result,
     const std::vector<ReconstructedLinePoint>& points,
     const std::unordered_map<int64_t, double>& exposure_time,

@@ -96,6 +96,7 @@ LinePointsEnu LinePointsInEnu(
 // track by the offset the lines agree on (line_offset.h); the points of
 // windows without one removed.
 void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
+                           const LateralOffsetOptions& options,
                            LinePointsEnu* points) {
   std::vector<Eigen::Vector2d> left_of;
   for (const Pose& pose : points->pose_of) {
@@ -103,7 +104,6 @@ void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
     const Eigen::Vector3d right = pose.q_enu_body * Eigen::Vector3d::UnitY();
     left_of.push_back(-right.head<2>().normalized());
   }
-  const LateralOffsetOptions options;
   const std::vector<LateralOffset> offsets = SearchLateralOffsets(
       points->enu, points->time_of, left_of, database, options);
   LinePointsEnu kept;
@@ -214,9 +214,9 @@ int AddDashControl(const std::vector<ReconstructedLinePoint>& points,
                    const std::vector<DatabaseLineEnu>& database,
                    const AdjustmentResult& zebra_result,
                    const AdjustmentOptions& options,
+                   const DashMatchOptions& dash_options,
                    std::vector<LineControlPoint>* control,
                    std::vector<LineMatch>* rows) {
-  const DashMatchOptions dash_options;
   const std::vector<int> db_dashes = DatabaseDashes(database, dash_options);
   if (db_dashes.empty()) return 0;
   // The database line each reconstructed line's kept points agree on, or
@@ -367,6 +367,7 @@ double PosteriorSdAt(const AdjustmentResult& result, double time) {
 
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration,
     const AdjustmentResult& zebra_result,
     const std::vector<ReconstructedLinePoint>* reconstructed_lines,
     const std::string& results_folder, std::vector<std::string>* warnings) {
@@ -392,15 +393,15 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   LinePointsEnu line_points =
       LinePointsInEnu(points, exposure_time, zebra_result);
   if (!zebra_result.summary.corrected) {
-    ShiftByLateralOffsets(database, &line_points);
+    ShiftByLateralOffsets(database, registration.lateral_offsets, &line_points);
   }
   const std::vector<LinePointMatch> all_matches =
-      MatchLinePoints(line_points.enu, database, LineMatchOptions());
+      MatchLinePoints(line_points.enu, database, registration.lines);
   std::vector<LinePointMatch> consistent;
   std::set<int> checked;
   std::vector<RejectedLine> rejected =
       RejectInconsistentLines(all_matches, line_points.time_of,
-                              LineConsistencyOptions(), &consistent, &checked);
+                              registration.consistency, &consistent, &checked);
   // A database line must also agree with the trajectory the zebra crossings
   // corrected, to what that trajectory's posterior sd allows: a line the
   // zebras place decimetres away is stale or mismatched, and would pull
@@ -466,11 +467,12 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   const size_t first_along = control.size();
   if (zebra_result.summary.corrected) {
     AddDashControl(points, line_points, matches, database, zebra_result,
-                   options, &control, &rows);
+                   options, registration.dashes, &control, &rows);
   }
   // Along the track too: the edges of crossings never seen whole.
-  AddCrossingEdgeControl(data, options, zebra_result, edge_points,
-                         exposure_time, &control, &rows);
+  AddCrossingEdgeControl(data, options, registration.crossing_edges,
+                         zebra_result, edge_points, exposure_time, &control,
+                         &rows);
   for (size_t i = first_along; i < control.size(); ++i) {
     stretches[static_cast<int>(
         std::floor((control[i].time - start_time) / stretch_s))][2] += 1;

@@ -14,6 +14,7 @@
 #include "pipeline/stage_results.h"
 #include "pipeline/stages.h"
 #include "registration/match_stage.h"
+#include "registration/paint_probe.h"
 #include "survey/math_util.h"
 #include "survey/output_crs.h"
 #include "survey/results.h"
@@ -27,17 +28,55 @@ double PeakMemoryMb() {
   return usage.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
-std::vector<std::string> SurveyInputFiles(const Survey& survey) {
-  std::vector<std::string> files = {survey.PathOf("survey.yaml")};
+// The options a stage reads, as JSON, without those no result depends on
+// (threads).
+nlohmann::json ReconstructOptionsJson(const RunOptions& options) {
+  nlohmann::json json = RunOptionsToJson(options);
+  nlohmann::json read = {{"lines", json["lines"]},
+                         {"reconstruction", json["reconstruction"]},
+                         {"road_lines", json["road_lines"]}};
+  read["reconstruction"].erase("threads");
+  return read;
+}
+nlohmann::json MatchOptionsJson(const RunOptions& options) {
+  nlohmann::json json = RunOptionsToJson(options);
+  return {{"matching", json["matching"]}, {"paint_probe", json["paint_probe"]}};
+}
+nlohmann::json AdjustOptionsJson(const RunOptions& options) {
+  nlohmann::json json = RunOptionsToJson(options);
+  nlohmann::json read;
+  for (const char* key :
+       {"tie_points", "lines", "rematch", "tie_point_matching",
+        "line_registration", "adjustment", "second_pass", "paint_probe"}) {
+    read[key] = json[key];
+  }
+  read["adjustment"]["solver"].erase("num_threads");
+  read["adjustment"]["solver"].erase("minimizer_progress_to_stdout");
+  return read;
+}
+
+// What each stage's result depends on (pipeline/run_state.h): the survey
+// files it reads, its options, and the stage before it.
+std::vector<std::string> StageFingerprints(const Survey& survey,
+                                           const RunOptions& options) {
+  StageFingerprint reconstruct;
+  reconstruct.Add("reconstruct").Add(ReconstructOptionsJson(options).dump());
+  reconstruct.AddFileContents(survey.PathOf("survey.yaml"));
   for (const std::string* file :
        {&survey.manifest.rig, &survey.manifest.trajectory,
-        &survey.manifest.exposures, &survey.manifest.roadmarks}) {
-    files.push_back(survey.PathOf(*file));
+        &survey.manifest.exposures}) {
+    reconstruct.AddFileContents(survey.PathOf(*file));
   }
   for (const ExposureImage& image : survey.exposures.images) {
-    files.push_back(survey.PathOf(image.image));
+    reconstruct.AddFileStamp(survey.PathOf(image.image));
   }
-  return files;
+  StageFingerprint match;
+  match.Add("match").Add(reconstruct.Hex());
+  match.Add(MatchOptionsJson(options).dump());
+  match.AddFileContents(survey.PathOf(survey.manifest.roadmarks));
+  StageFingerprint adjust;
+  adjust.Add("adjust").Add(match.Hex()).Add(AdjustOptionsJson(options).dump());
+  return {reconstruct.Hex(), match.Hex(), adjust.Hex()};
 }
 
 // reconstruct: the zebra bands, then the road lines on the road plane the
@@ -50,7 +89,7 @@ std::vector<std::string> Reconstruct(
       survey, options.reconstruction, results, progress, &road_plane);
   if (options.lines) {
     for (const std::string& w :
-         RunRoadLinesStage(survey, road_plane, RoadLineOptions(),
+         RunRoadLinesStage(survey, road_plane, options.road_lines,
                            options.threads, results, nullptr)) {
       warnings.push_back(w);
     }
@@ -63,7 +102,7 @@ std::vector<std::string> Match(const Survey& survey, StageResults* results,
                                const std::function<void(int, int)>& progress) {
   MatchResult result =
       RunMatchStage(survey, results->Vertices(), results->folder(),
-                    options.matching, progress);
+                    options.matching, options.paint_probe, progress);
   if (!result.summary.IsUsable()) {
     throw StageFailedError("match: " + result.summary.message);
   }
@@ -110,13 +149,19 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
   }
   const std::set<std::string> rejected = RejectedCrossingsIn(results->folder());
   first.rejected_crossings = &rejected;
+  ImagePaintProbe probe(survey, options.paint_probe);
+  first.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
+                               const BandCornersEnu& band,
+                               const std::vector<BandCornersEnu>& seen) {
+    return probe.Classify(exposure_id, pose, band, seen);
+  };
   std::optional<RoadLinesAdjustment> lines;
   if (first.adjustment != nullptr &&
       SecondPassOnRoadLines(*first.adjustment, results->Decisions(),
-                            options.lines)) {
+                            options.lines, options.second_pass)) {
     lines = AdjustByRoadLinesAlone(
         AdjustmentDataOf(survey, results->Vertices(), {}),
-        results->LinePoints(), options.adjustment);
+        results->LinePoints(), options.adjustment, options.line_registration);
     if (lines) {
       first.adjustment = &lines->record;
       first.adjusted_trajectory = &lines->trajectory;
@@ -124,7 +169,7 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
     }
   }
   RematchSummary rematch = RematchWithAdjustedTrajectory(
-      survey, first, options.matching, RematchOptions());
+      survey, first, options.matching, options.second_pass);
   if (lines) {
     rematch.message +=
         " (searched on the trajectory the road lines alone "
@@ -138,7 +183,7 @@ RematchSummary Rematch(const Survey& survey, StageResults* results,
       first.line_control_times = &line_times.fitted;
       first.across_from_fitted_lines = true;
       rematch = RematchWithAdjustedTrajectory(survey, first, options.matching,
-                                              RematchOptions());
+                                              options.second_pass);
       rematch.message +=
           " (searched on the adjusted trajectory near the road lines it "
           "fits: too few crossings for its error model)";
@@ -165,12 +210,12 @@ std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
   // With the second pass, the first adjustment may not be the result: its
   // warnings go to the report (and stderr, tools/run_command.cc) only if
   // it is.
-  AdjustmentOptions first = options.adjustment;
-  first.log_warnings = !options.rematch;
+  RunOptions first = options;
+  first.adjustment.log_warnings = !options.rematch;
   AdjustedLineTimes line_times;
   std::vector<std::string> warnings =
-      RunAdjustStage(survey, results, first, options.tie_points, options.lines,
-                     progress, &line_times.control, &line_times.fitted);
+      RunAdjustStage(survey, results, first, progress, &line_times.control,
+                     &line_times.fitted);
   if (!options.rematch) return warnings;
   // Crossings the first pass could not decide, matched again with the
   // adjusted trajectory. A pass that refused first-pass crossings it
@@ -189,9 +234,9 @@ std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
       break;
     }
     const bool again = pass + 1 < kMaxRematchPasses;
-    warnings = RunAdjustStage(
-        survey, results, again ? first : options.adjustment, options.tie_points,
-        options.lines, progress, &line_times.control, &line_times.fitted);
+    warnings =
+        RunAdjustStage(survey, results, again ? first : options, progress,
+                       &line_times.control, &line_times.fitted);
     if (!again) break;
   }
   warnings.insert(warnings.end(), refusals.begin(), refusals.end());
@@ -200,56 +245,46 @@ std::vector<std::string> Adjust(const Survey& survey, StageResults* results,
 
 }  // namespace
 
-std::string RunOptions::Check() const {
-  if (threads < 0) {
-    return "threads = " + std::to_string(threads) + ": must be >= 0";
-  }
-  for (const std::string& problem : {reconstruction.Check(), matching.Check(),
-                                     adjustment.Check(), report.Check()}) {
-    if (!problem.empty()) return problem;
-  }
-  return "";
-}
-
 RunSummary RunSurveyPipeline(const Survey& survey,
                              const std::string& results_folder,
                              const RunOptions& options,
-                             const ProgressListener& progress) {
+                             const RunContext& context) {
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError(problem);
+  const ProgressListener& progress = context.progress;
   // The stage outputs, handed from stage to stage in memory; what a
   // resumed run skips is read from the folder on first use.
   StageResults stage_results(results_folder);
   StageResults* results = &stage_results;
 
-  std::vector<PipelineStage> stages;
-  std::vector<std::string> reconstruct_outputs = {kReconstructedBandsFile,
-                                                  kSkippedExposuresFile};
-  if (options.lines) reconstruct_outputs.push_back(kReconstructedLinesFile);
-  stages.push_back({"reconstruct", reconstruct_outputs,
-                    [&](const std::function<void(int, int)>& step) {
-                      return Reconstruct(survey, results, options, step);
-                    }});
-  stages.push_back({"match",
-                    {kMatchesFile, kCrossingDecisionsFile},
-                    [&](const std::function<void(int, int)>& step) {
-                      return Match(survey, results, options, step);
-                    }});
-  stages.push_back({"adjust",
-                    {kTrajectoryCorrectedFile, kPosesFile, kGcpResidualsFile,
-                     kBandsGeoJsonFile},
-                    [&](const std::function<void(int, int)>&) {
-                      return Adjust(survey, results, options, progress);
-                    }});
-  std::ostringstream settings;
-  settings << "threads-independent;ties=" << options.tie_points
-           << ";lines=" << options.lines << ";sideslip="
-           << RadToDeg(options.adjustment.vehicle_motion.sideslip_sigma_rad)
-           << ";rematch=" << options.rematch;
-  const PipelineRun run =
-      RunPipeline(results_folder,
-                  InputFingerprint(SurveyInputFiles(survey), settings.str()),
-                  stages, PipelineOptions{options.from_stage}, progress);
+  const std::vector<std::string> fingerprints =
+      StageFingerprints(survey, options);
+  std::vector<PipelineStage> stages(3);
+  stages[0].name = "reconstruct";
+  stages[0].outputs = {kReconstructedBandsFile, kSkippedExposuresFile};
+  if (options.lines) stages[0].outputs.push_back(kReconstructedLinesFile);
+  stages[0].run = [&](const std::function<void(int, int)>& step) {
+    return Reconstruct(survey, results, options, step);
+  };
+  stages[1].name = "match";
+  stages[1].outputs = {kMatchesFile, kCrossingDecisionsFile};
+  stages[1].run = [&](const std::function<void(int, int)>& step) {
+    return Match(survey, results, options, step);
+  };
+  stages[2].name = "adjust";
+  stages[2].outputs = {kTrajectoryCorrectedFile, kPosesFile, kGcpResidualsFile,
+                       kBandsGeoJsonFile};
+  // matches.csv and crossing_decisions.csv: the control the adjustment
+  // kept and what the second registration pass added.
+  stages[2].rewrites = {"match"};
+  stages[2].run = [&](const std::function<void(int, int)>&) {
+    return Adjust(survey, results, options, progress);
+  };
+  for (size_t i = 0; i < stages.size(); ++i) {
+    stages[i].fingerprint = fingerprints[i];
+  }
+  const PipelineRun run = RunPipeline(
+      results_folder, stages, PipelineOptions{context.from_stage}, progress);
 
   ReportInputs inputs;
   inputs.survey = &survey;

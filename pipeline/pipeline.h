@@ -19,32 +19,21 @@
 #include <string>
 #include <vector>
 
-#include "adjustment/trajectory_adjuster.h"
 #include "pipeline/progress.h"
 #include "pipeline/report.h"
-#include "reconstruction/reconstruction.h"
-#include "registration/band_matcher.h"
+#include "pipeline/run_options.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
 
-struct RunOptions {
-  // Redo from this stage: reconstruct, match or adjust. Empty: resume after
-  // the last complete stage.
+// How one run is carried out, beside its options (which are data and
+// decide its results).
+struct RunContext {
+  // Progress of every step (pipeline/progress.h).
+  ProgressListener progress;
+  // Redo from this stage: reconstruct, match or adjust. Empty: resume
+  // after the last complete stage (pipeline/run_state.h).
   std::string from_stage;
-  bool tie_points = true;
-  bool lines = true;    // road lines as control beside the zebras (issue 9)
-  bool rematch = true;  // second registration pass, adjusted trajectory
-  // Worker threads of the road-line extraction (0: one per hardware thread);
-  // the other stages take theirs from their options.
-  int threads = 0;
-  ReconstructionOptions reconstruction;
-  MatchOptions matching;
-  AdjustmentOptions adjustment;
-  ReportOptions report;
-
-  // "" or the first problem of the stages' options.
-  std::string Check() const;
 };
 
 struct RunSummary {
@@ -60,7 +49,7 @@ struct RunSummary {
 RunSummary RunSurveyPipeline(const Survey& survey,
                              const std::string& results_folder,
                              const RunOptions& options,
-                             const ProgressListener& progress = {});
+                             const RunContext& context = {});
 
 }  // namespace zebrageo
 

@@ -14,12 +14,12 @@
 #include <tuple>
 
 #include "pipeline/report_data.h"
+#include "pipeline/version.h"
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
-#include "survey/results.h"
 #include "survey/option_check.h"
+#include "survey/results.h"
 #include "survey/results_adjustment.h"
-#include "tools/version.h"
 
 namespace zebrageo {
 using report_internal::Collect;

@@ -33,6 +33,12 @@ struct ReportOptions {
   double max_sigma0 = 2.0;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_uncontrolled_stretch_m", max_uncontrolled_stretch_m);
+    v("control_radius_m", control_radius_m);
+    v("max_sigma0", max_sigma0);
+  }
 };
 
 struct ReportInputs {

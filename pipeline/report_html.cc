@@ -4,7 +4,7 @@
 
 #include "pipeline/report_data.h"
 #include "pipeline/svg_plot.h"
-#include "tools/version.h"
+#include "pipeline/version.h"
 
 namespace zebrageo {
 namespace report_internal {

@@ -17,6 +17,7 @@
 #include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "pipeline/progress.h"
+#include "pipeline/run_options.h"
 #include "pipeline/stage_results.h"
 #include "reconstruction/reconstruction.h"
 #include "reconstruction/road_lines.h"
@@ -57,9 +58,10 @@ void ThrowIfTooManyUnreadable(const Survey& survey,
 // adjustment.json's); exposures the reconstruction skipped get no pose.
 // *line_control_times and *fitted_line_times (when not null):
 // AdjustWithRoadLines'.
+// The run's options it reads: tie_points, lines, tie_point_matching,
+// line_registration and adjustment.
 std::vector<std::string> RunAdjustStage(
-    const Survey& survey, StageResults* results,
-    const AdjustmentOptions& options, bool tie_points, bool lines,
+    const Survey& survey, StageResults* results, const RunOptions& options,
     const ProgressListener& progress,
     std::vector<double>* line_control_times = nullptr,
     std::vector<double>* fitted_line_times = nullptr);
@@ -78,6 +80,7 @@ inline constexpr double kFittedLineResidualM = 0.1;
 AdjustmentResult AdjustWithRoadLines(
     const AdjustmentData& data, AdjustmentInput input,
     const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration,
     const std::vector<ReconstructedLinePoint>* line_points,
     const std::string& results_folder, std::vector<std::string>* warnings,
     const ProgressListener& progress,
@@ -92,7 +95,7 @@ AdjustmentResult AdjustWithRoadLines(
 // left undecided.
 bool SecondPassOnRoadLines(const AdjustmentRecord& record,
                            const std::vector<CrossingDecision>& decisions,
-                           bool lines);
+                           bool lines, const RematchOptions& rematch);
 
 // The trajectory of `data` corrected by the road lines alone (its zebra
 // matches left out: adjustment.json's road_lines_only), and what
@@ -110,7 +113,8 @@ struct RoadLinesAdjustment {
 std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
     const AdjustmentData& data,
     const std::vector<ReconstructedLinePoint>* line_points,
-    const AdjustmentOptions& options);
+    const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration);
 
 // The reconstructed road-line points (what reconstructed_lines.csv holds)
 // matched to the database lines with the trajectory of `zebra_result`,
@@ -121,6 +125,7 @@ std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
 // null (reconstructed without lines) or the database has no lines.
 std::vector<LineControlPoint> MatchLinesForAdjustment(
     const AdjustmentData& data, const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration,
     const AdjustmentResult& zebra_result,
     const std::vector<ReconstructedLinePoint>* reconstructed_lines,
     const std::string& results_folder, std::vector<std::string>* warnings);

@@ -70,6 +70,21 @@ struct ReconstructionOptions {
   uint64_t seed = 1;  // RANSAC
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("rectification", rectification);
+    v("edges", edges);
+    v("matching", matching);
+    v("search", search);
+    v("road_plane", road_plane);
+    v("zebra", zebra);
+    v("long_sides", long_sides);
+    v("bands", bands);
+    v("threads", threads);
+    v("batch_exposures", batch_exposures);
+    v("debug_image_folder", debug_image_folder);
+    v("seed", seed);
+  }
 };
 
 // Seconds spent in each step, summed over stereo pairs (CPU time of the

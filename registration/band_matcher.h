@@ -212,6 +212,49 @@ struct MatchOptions {
 
   // "" or the first invalid field, e.g. "max_drift_m = -1: must be > 0".
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_drift_m", max_drift_m);
+    v("sd_gate_factor", sd_gate_factor);
+    v("max_heading_error_rad", max_heading_error_rad);
+    v("max_cross_track_m", max_cross_track_m);
+    v("min_band_length_m", min_band_length_m);
+    v("max_band_length_m", max_band_length_m);
+    v("min_band_width_m", min_band_width_m);
+    v("max_band_width_m", max_band_width_m);
+    v("max_length_difference_m", max_length_difference_m);
+    v("max_width_difference_m", max_width_difference_m);
+    v("hit_tolerance_m", hit_tolerance_m);
+    v("vertex_tolerance_m", vertex_tolerance_m);
+    v("missing_band_weight", missing_band_weight);
+    v("max_missing_views", max_missing_views);
+    v("contradiction_weight", contradiction_weight);
+    v("unexplained_band_weight", unexplained_band_weight);
+    v("visibility_margin_px", visibility_margin_px);
+    v("visibility_safety_px", visibility_safety_px);
+    v("visibility_range_m", visibility_range_m);
+    v("probe_range_m", probe_range_m);
+    v("window_s", window_s);
+    v("same_correction_tolerance_m", same_correction_tolerance_m);
+    v("drift_rate_m_per_s", drift_rate_m_per_s);
+    v("min_hit_bands", min_hit_bands);
+    v("min_margin", min_margin);
+    v("require_both_ends", require_both_ends);
+    v("min_strong_margin", min_strong_margin);
+    v("neighbour_window_s", neighbour_window_s);
+    v("neighbour_tolerance_m", neighbour_tolerance_m);
+    v("max_drift_rate_m_per_s", max_drift_rate_m_per_s);
+    v("max_informative_tolerance_m", max_informative_tolerance_m);
+    v("resolve_base_m", resolve_base_m);
+    v("max_drift_acceleration_m_per_s2", max_drift_acceleration_m_per_s2);
+    v("max_drift_per_metre", max_drift_per_metre);
+    v("max_resolve_bound_m", max_resolve_bound_m);
+    v("max_exclusion_bound_m", max_exclusion_bound_m);
+    v("max_sd_ratio", max_sd_ratio);
+    v("shifted_crossing_threshold_m", shifted_crossing_threshold_m);
+    v("refuse_shifted_crossings", refuse_shifted_crossings);
+    v("min_views_for_fault", min_views_for_fault);
+  }
 };
 
 // A horizontal correction of the measured pose at one exposure (see the

@@ -350,6 +350,7 @@ void WriteMatchesGeoJson(const MatchInput& input, const MatchResult& result,
 MatchResult RunMatchStage(const Survey& survey,
                           const std::string& results_folder,
                           const MatchOptions& options,
+                          const PaintProbeOptions& paint_probe,
                           const std::function<void(int, int)>& progress) {
   const std::string input_path =
       (fs::path(results_folder) / kReconstructedBandsFile).string();
@@ -361,13 +362,14 @@ MatchResult RunMatchStage(const Survey& survey,
   }
   return RunMatchStage(
       survey, ReadReconstructedBands(input_path, kReconstructedBandsFile),
-      results_folder, options, progress);
+      results_folder, options, paint_probe, progress);
 }
 
 MatchResult RunMatchStage(const Survey& survey,
                           const std::vector<ReconstructedVertex>& vertices,
                           const std::string& results_folder,
                           const MatchOptions& options,
+                          const PaintProbeOptions& paint_probe,
                           const std::function<void(int, int)>& progress) {
   int incomplete = 0;
   MatchInput input;
@@ -377,7 +379,7 @@ MatchResult RunMatchStage(const Survey& survey,
   const RoadmarkIndex index(survey.roadmarks, survey.frame);
   input.index = &index;
   input.rig = &survey.rig;
-  ImagePaintProbe probe(survey);
+  ImagePaintProbe probe(survey, paint_probe);
   input.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
                                const BandCornersEnu& band,
                                const std::vector<BandCornersEnu>& seen) {

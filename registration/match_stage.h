@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "registration/band_matcher.h"
+#include "registration/paint_probe.h"
 #include "registration/roadmark_index.h"
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
@@ -59,12 +60,14 @@ MatchResult RunMatchStage(const Survey& survey,
                           const std::vector<ReconstructedVertex>& vertices,
                           const std::string& results_folder,
                           const MatchOptions& options,
+                          const PaintProbeOptions& paint_probe = {},
                           const std::function<void(int, int)>& progress = {});
 // The same with the bands read from results_folder/reconstructed_bands.csv
 // (InputError when missing or unreadable).
 MatchResult RunMatchStage(const Survey& survey,
                           const std::string& results_folder,
                           const MatchOptions& options,
+                          const PaintProbeOptions& paint_probe = {},
                           const std::function<void(int, int)>& progress = {});
 
 // The second registration pass of `zebrageo run`: the observations the first
@@ -153,6 +156,20 @@ struct RematchOptions {
   // needs.
   double max_sideways_m = 0.2;
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("min_control_crossings", min_control_crossings);
+    v("gate_m", gate_m);
+    v("sd_gate_factor", sd_gate_factor);
+    v("max_heading_error_rad", max_heading_error_rad);
+    v("min_hit_bands", min_hit_bands);
+    v("cross_track_gate_m", cross_track_gate_m);
+    v("max_line_control_gap_m", max_line_control_gap_m);
+    v("max_line_drift_sd_m", max_line_drift_sd_m);
+    v("max_line_bracket_gap_s", max_line_bracket_gap_s);
+    v("max_cross_track_control_gap_m", max_cross_track_control_gap_m);
+    v("max_sideways_m", max_sideways_m);
+  }
 };
 struct RematchSummary {
   int observations = 0;   // undecided after the first pass

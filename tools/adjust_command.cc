@@ -26,11 +26,15 @@ struct AdjustArguments {
 };
 
 void RunAdjust(const AdjustArguments& args) {
-  AdjustmentOptions options;
-  options.control.check_crossing_share = args.check_share;
-  options.rig_calibration.self_calibrate_rig = args.self_calibrate;
-  options.solver.num_threads = args.threads;
-  options.vehicle_motion.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
+  RunOptions options;
+  options.tie_points = args.tie_points;
+  options.lines = args.lines;
+  AdjustmentOptions& adjustment = options.adjustment;
+  adjustment.control.check_crossing_share = args.check_share;
+  adjustment.rig_calibration.self_calibrate_rig = args.self_calibrate;
+  adjustment.solver.num_threads = args.threads;
+  adjustment.vehicle_motion.sideslip_sigma_rad =
+      DegToRad(args.sideslip_sigma_deg);
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
   ResultsSession session(args.stage.results,
@@ -42,8 +46,7 @@ void RunAdjust(const AdjustArguments& args) {
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
   session.Open();
   StageResults results(args.stage.results);
-  RunAdjustStage(survey, &results, options, args.tie_points, args.lines,
-                 ProgressBars());
+  RunAdjustStage(survey, &results, options, ProgressBars());
   session.Succeeded();
 }
 

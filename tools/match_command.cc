@@ -74,7 +74,8 @@ void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
          }
          ProgressBar bar("match");
          const MatchResult result =
-             RunMatchStage(survey, args->results, *options, bar.Callback());
+             RunMatchStage(survey, args->results, *options, PaintProbeOptions(),
+                           bar.Callback());
          bar.Finish();
          if (!result.summary.IsUsable()) {
            throw StageFailedError(result.summary.message);

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/version.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
-#include "tools/version.h"
 
 namespace zebrageo {
 namespace {

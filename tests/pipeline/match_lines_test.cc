@@ -107,8 +107,9 @@ class MatchLinesForAdjustmentTest : public ::testing::Test {
 
 TEST_F(MatchLinesForAdjustmentTest, ControlLiesOnThePaintAndTheStaleLineIsOut) {
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
+                              folder_.Path(), &warnings);
 
   // Nearly every point of the three true lines is control (the database
   // lines are long enough for all of them).
@@ -153,8 +154,9 @@ TEST_F(MatchLinesForAdjustmentTest, WithoutZebraControlTheLinesFindTheOffset) {
   zebra_.summary.corrected = false;
   for (Pose& pose : zebra_.corrected_poses) pose.p_enu.y() -= 1.6;
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
+                              folder_.Path(), &warnings);
   EXPECT_GE(static_cast<int>(control.size()), 3 * points_per_line_ * 8 / 10);
   for (const LineControlPoint& c : control) {
     const Eigen::Vector3d p_enu = TruePose(c.time).T_enu_body() * c.p_body;
@@ -219,8 +221,9 @@ TEST_F(MatchLinesForAdjustmentTest, WholeDashesControlTheAlongTrackPosition) {
   const int whole = AddDashes(&data_, &points_, 5.25 + 3.5);
   ASSERT_GT(whole, 20);
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
+                              folder_.Path(), &warnings);
   int along = 0;
   for (const LineControlPoint& c : control) {
     if (!c.along_track) continue;
@@ -261,14 +264,14 @@ TEST_F(MatchLinesForAdjustmentTest, NoDashOutsideTheAlongTrackGate) {
   for (Pose& pose : zebra_.corrected_poses) pose.p_enu.x() -= 0.5;
   std::vector<std::string> warnings;
   for (const LineControlPoint& c :
-       MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_, &points_,
+       MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
                                folder_.Path(), &warnings)) {
     EXPECT_FALSE(c.along_track);
   }
   zebra_.summary.corrected = false;
   for (Pose& pose : zebra_.corrected_poses) pose.p_enu.x() += 0.5;
   for (const LineControlPoint& c :
-       MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_, &points_,
+       MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
                                folder_.Path(), &warnings)) {
     EXPECT_FALSE(c.along_track);
   }
@@ -315,7 +318,7 @@ TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
     std::vector<std::string> warnings;
     std::vector<LineControlPoint> along;
     for (const LineControlPoint& c : MatchLinesForAdjustment(
-             data_, AdjustmentOptions(), zebra_, &points, "", &warnings)) {
+             data_, AdjustmentOptions(), {}, zebra_, &points, "", &warnings)) {
       if (c.along_track) along.push_back(c);
     }
     return along;
@@ -343,7 +346,7 @@ TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
 
 TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
   std::vector<std::string> warnings;
-  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
+  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_,
                                       nullptr, folder_.Path(), &warnings)
                   .empty());
   EXPECT_TRUE(warnings.empty());
@@ -353,7 +356,7 @@ TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
 TEST_F(MatchLinesForAdjustmentTest, ADatabaseWithoutLinesIsAWarning) {
   data_.roadmarks.lines.clear();
   std::vector<std::string> warnings;
-  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
+  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_,
                                       &points_, folder_.Path(), &warnings)
                   .empty());
   ASSERT_EQ(warnings.size(), 1u);

@@ -300,10 +300,12 @@ RematchSummary SecondPass(
   const std::set<std::string> rejected_crossings = RejectedCrossings(adjusted);
   first.rejected_crossings = &rejected_crossings;
   std::optional<RoadLinesAdjustment> on_lines;
-  if (SecondPassOnRoadLines(record, *decisions, lines != nullptr)) {
+  if (SecondPassOnRoadLines(record, *decisions, lines != nullptr,
+                            RematchOptions())) {
     AdjustmentData without_matches = *data;
     without_matches.matches.clear();
-    on_lines = AdjustByRoadLinesAlone(without_matches, lines, adjustment);
+    on_lines = AdjustByRoadLinesAlone(without_matches, lines, adjustment,
+                                      LineRegistrationOptions());
     if (on_lines) {
       first.adjustment = &on_lines->record;
       first.adjusted_trajectory = &on_lines->trajectory;
@@ -357,9 +359,9 @@ int RematchAndAdjust(const Survey& survey,
     data->matches = std::move(rematch.matches);
     decisions = std::move(rematch.decisions);
     std::vector<std::string> warnings;
-    *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
-                                    &warnings, nullptr, &times_after,
-                                    &fitted_line_times);
+    *adjusted = AdjustWithRoadLines(
+        *data, data->Input(), adjustment, LineRegistrationOptions(), lines, "",
+        &warnings, nullptr, &times_after, &fitted_line_times);
   }
   return added;
 }
@@ -442,8 +444,8 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     std::vector<double> line_control_times;
     std::vector<double> fitted_line_times;
     AdjustmentResult adjusted = AdjustWithRoadLines(
-        data, data.Input(), adjustment, lines, "", &warnings, nullptr,
-        &line_control_times, &fitted_line_times);
+        data, data.Input(), adjustment, LineRegistrationOptions(), lines, "",
+        &warnings, nullptr, &line_control_times, &fitted_line_times);
     int rejected_first = 0;
     if (options.rematch && adjusted.summary.IsUsable()) {
       result.rematched =
