@@ -223,7 +223,7 @@ struct BlunderOptions {
   }
 };
 
-// Matched road lines as control (line_control.h).
+// Matched road lines as control (line_costs.h).
 struct LineControlOptions {
   // Cauchy loss on the point-to-line residuals, in sigmas.
   double line_loss_scale = 3.0;

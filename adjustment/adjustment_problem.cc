@@ -38,9 +38,31 @@ AdjustmentProblem::AdjustmentProblem(const AdjustmentOptions& options,
   AddVehicleMotion();
 }
 
-ceres::Solver::Summary AdjustmentProblem::Solve() {
+namespace {
+
+// Ends the solve between iterations once the run is cancelled.
+class CancelCallback : public ceres::IterationCallback {
+ public:
+  explicit CancelCallback(const CancellationToken& cancel) : cancel_(cancel) {}
+  ceres::CallbackReturnType operator()(
+      const ceres::IterationSummary&) override {
+    return cancel_.IsCancelled() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const CancellationToken& cancel_;
+};
+
+}  // namespace
+
+ceres::Solver::Summary AdjustmentProblem::Solve(
+    const CancellationToken& cancel) {
   ceres::Solver::Options solver_options =
       ToCeresOptions(options_.solver, num_pose_blocks_);
+  CancelCallback cancel_callback(cancel);
+  if (cancel.flag() != nullptr) {
+    solver_options.callbacks.push_back(&cancel_callback);
+  }
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (ControlPoint& p : state_->points) {
     if (p.status == ControlStatus::kControl) {

@@ -53,9 +53,12 @@ bool AdjustmentSolver::HasControl() const {
 
 bool AdjustmentSolver::Solve(bool robust) {
   AdjustmentSummary& summary = *context_.summary;
+  context_.cancel.ThrowIfCancelled();
   problem_ = std::make_unique<AdjustmentProblem>(
       context_.options, *context_.input.rig, robust, state_);
-  const ceres::Solver::Summary s = problem_->Solve();
+  const ceres::Solver::Summary s = problem_->Solve(context_.cancel);
+  // A solve the cancellation stopped is no result.
+  context_.cancel.ThrowIfCancelled();
   ++summary.solves;
   summary.iterations += static_cast<int>(s.iterations.size()) - 1;
   summary.num_residuals = s.num_residuals;

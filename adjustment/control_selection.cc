@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "adjustment/line_discrepancies.h"
+#include "survey/csv.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
@@ -17,12 +18,6 @@ namespace {
 // Above this many crossings the leave-one-out test keeps the error model
 // fitted on all of them (a refit per crossing would cost n^4).
 constexpr int kMaxCrossingsForRefit = 40;
-
-std::string Fixed(double value, int decimals) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(decimals) << value;
-  return out.str();
-}
 
 // -log of the upper tail probability of a chi-square of `dof` (1 to 3)
 // degrees of freedom at `x`: crossings tested on different numbers of axes
@@ -332,22 +327,23 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
     const Eigen::Vector3d& d = crossings[worst].value_m;
     verdict.reason =
         "crossing " + names[worst] +
-        " implies a trajectory correction (along-track " + Fixed(d.x(), 2) +
-        " m, cross-track " + Fixed(d.y(), 2) + " m, up " + Fixed(d.z(), 2) +
-        " m) that " + (count > 1 ? "the other crossings, " : "") +
+        " implies a trajectory correction (along-track " +
+        FormatFixed(d.x(), 2) + " m, cross-track " + FormatFixed(d.y(), 2) +
+        " m, up " + FormatFixed(d.z(), 2) + " m) that " +
+        (count > 1 ? "the other crossings, " : "") +
         (voting.empty() ? std::string()
          : count > 1    ? "the road lines (across the track; whole "
                           "lane-line dashes along it), "
                         : "the road lines across the track, ") +
         "and the GNSS/INS error model do not explain (chi-square " +
-        Fixed(worst_chi, 1) + " > " + Fixed(threshold, 1) +
+        FormatFixed(worst_chi, 1) + " > " + FormatFixed(threshold, 1) +
         (worst_dof == 3   ? std::string()
          : worst_dof == 1 ? " on the one axis they measure"
                           : " on the two axes they measure") +
         ")";
     if (verdict.one_period_off) {
       verdict.reason += "; shifted by one band period (" +
-                        Fixed(period.norm(), 2) +
+                        FormatFixed(period.norm(), 2) +
                         " m) it would fit: matched one band off";
     } else {
       verdict.reason += ": repainted, or wrongly matched";

@@ -30,15 +30,10 @@
 #include "adjustment/control_selection.h"
 #include "adjustment/covariance.h"
 #include "adjustment/trajectory_jumps.h"
+#include "survey/csv.h"
 
 namespace zebrageo {
 namespace {
-
-std::string FixedText(double value, int decimals) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(decimals) << value;
-  return out.str();
-}
 
 using adjustment_internal::AdjustmentSolver;
 using adjustment_internal::Context;
@@ -114,9 +109,10 @@ void SelectControl(const Context& context, const CrossingTable& crossings,
 
 }  // namespace
 
-AdjustmentResult AdjustTrajectory(
-    const AdjustmentOptions& options, const AdjustmentInput& input,
-    const std::function<void(int, int)>& progress) {
+AdjustmentResult AdjustTrajectory(const AdjustmentOptions& options,
+                                  const AdjustmentInput& input,
+                                  const std::function<void(int, int)>& progress,
+                                  const CancellationToken& cancel) {
   const auto start = std::chrono::steady_clock::now();
   AdjustmentResult result;
   AdjustmentSummary& summary = result.summary;
@@ -129,15 +125,15 @@ AdjustmentResult AdjustTrajectory(
       RemoveJumps(*input.trajectory, options.trajectory_faults.jump_threshold_m,
                   options.trajectory_faults.jump_threshold_rad,
                   options.trajectory_faults.sideways_switches),
-      &summary};
+      &summary, cancel};
   summary.num_jumps = context.dejumped.num_jumps;
   for (const SidewaysSwitch& s : context.dejumped.switches) {
     const std::vector<TrajectorySample>& samples = input.trajectory->samples();
     context.Warn(
-        "the GNSS/INS positions move " + FixedText(std::abs(s.size_m), 2) +
+        "the GNSS/INS positions move " + FormatFixed(std::abs(s.size_m), 2) +
         " m " + (s.size_m > 0.0 ? "right" : "left") +
-        " of the heading from time " + FixedText(samples[s.first].time, 2) +
-        " to " + FixedText(samples[s.last].time, 2) +
+        " of the heading from time " + FormatFixed(samples[s.first].time, 2) +
+        " to " + FormatFixed(samples[s.last].time, 2) +
         ": a switch of the GNSS error (multipath?), corrected as "
         "continuous INS motion");
   }

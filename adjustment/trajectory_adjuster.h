@@ -21,7 +21,7 @@
 //     sample to sample, each exposure has its own offset on top
 //     (trajectory_jitter.h);
 //   - the vehicle's motion: it moves along its heading (vehicle_motion.h),
-//     Cauchy loss; road-line points (line_control.h), Cauchy loss.
+//     Cauchy loss; road-line points (line_costs.h), Cauchy loss.
 // The soft constraints' sigmas are checked against their residuals and
 // widened where the data show more spread (variance components). Solved
 // with Ceres (SPARSE_SCHUR on SuiteSparse: points eliminated, the banded
@@ -47,8 +47,9 @@
 #include <vector>
 
 #include "adjustment/adjustment_options.h"
-#include "adjustment/line_control.h"
+#include "adjustment/line_costs.h"
 #include "adjustment/trajectory_correction.h"
+#include "survey/cancellation.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/math_util.h"
@@ -210,10 +211,12 @@ struct AdjustmentResult {
 // poses: a failed solve gives summary.usable = false and the reason in
 // summary.message. Without any usable control the input trajectory is
 // returned unchanged with a warning (usable). `progress(done, total)` is
-// called after each solve when set.
+// called after each solve when set. Throws CancelledError when `cancel` is
+// cancelled (checked between solves and between the solver's iterations).
 AdjustmentResult AdjustTrajectory(
     const AdjustmentOptions& options, const AdjustmentInput& input,
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

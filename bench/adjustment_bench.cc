@@ -60,8 +60,8 @@
 #include <string>
 #include <vector>
 
-#include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
+#include "pipeline/adjustment_pass.h"
 #include "tests/support/synthetic_survey.h"
 #include "tiepoints/tie_points.h"
 

@@ -1,6 +1,6 @@
 // What the report shows, gathered once from a results folder and the survey
-// (pipeline/report.h); shared by the report's JSON (report.cc) and its HTML
-// page (report_html.cc). Internal to the pipeline library.
+// (pipeline/report_stage.h); shared by the report's JSON (report_stage.cc) and
+// its HTML page (report_html.cc). Internal to the pipeline library.
 #ifndef ZEBRAGEO_PIPELINE_REPORT_DATA_H_
 #define ZEBRAGEO_PIPELINE_REPORT_DATA_H_
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 #include "survey/results.h"
 
 namespace zebrageo {

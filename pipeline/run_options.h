@@ -13,13 +13,13 @@
 #include <string>
 
 #include "adjustment/adjustment_options.h"
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 #include "reconstruction/reconstruction.h"
 #include "reconstruction/road_lines.h"
 #include "registration/band_matcher.h"
 #include "registration/line_registration.h"
-#include "registration/match_stage.h"
 #include "registration/paint_probe.h"
+#include "registration/rematch.h"
 #include "tiepoints/tie_points.h"
 
 namespace zebrageo {

@@ -149,7 +149,8 @@ std::string StageFingerprint::Hex() const {
 PipelineRun RunPipeline(const std::string& results_folder,
                         const std::vector<PipelineStage>& stages,
                         const PipelineOptions& options,
-                        const ProgressListener& progress) {
+                        const ProgressListener& progress,
+                        const CancellationToken& cancel) {
   const int from_index =
       options.from_stage.empty() ? -1 : StageIndex(stages, options.from_stage);
   if (!options.from_stage.empty() && from_index < 0) {
@@ -181,6 +182,7 @@ PipelineRun RunPipeline(const std::string& results_folder,
       }
       continue;
     }
+    cancel.ThrowIfCancelled();
     // Recorded as incomplete before it starts, so a kill during it never
     // leaves it looking complete; the stages whose outputs it rewrites no
     // longer hold their own.

@@ -25,7 +25,8 @@
 #include <vector>
 
 #include "pipeline/progress.h"
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
+#include "survey/cancellation.h"
 
 namespace zebrageo {
 
@@ -77,11 +78,13 @@ class StageFingerprint {
   uint64_t hash_;
 };
 
-// Throws UsageError for an unknown from_stage.
+// Throws UsageError for an unknown from_stage, CancelledError when
+// `cancel` is cancelled between stages (the stages check it inside).
 PipelineRun RunPipeline(const std::string& results_folder,
                         const std::vector<PipelineStage>& stages,
                         const PipelineOptions& options,
-                        const ProgressListener& progress = {});
+                        const ProgressListener& progress = {},
+                        const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

@@ -377,7 +377,8 @@ RoadPlane InitialRoadPlane(const Survey& survey, const StereoPairs& pairs,
 std::vector<ExposureResult> ProcessExposures(
     const Survey& survey, const StereoPairs& pairs,
     const ReconstructionOptions& options, int threads,
-    const ProgressCallback& progress, RoadPlaneTracker* running) {
+    const ProgressCallback& progress, const CancellationToken& cancel,
+    RoadPlaneTracker* running) {
   const std::vector<Exposure>& exposures = survey.exposures.exposures;
   std::vector<ExposureResult> results(exposures.size());
   std::mutex progress_mutex;
@@ -387,6 +388,7 @@ std::vector<ExposureResult> ProcessExposures(
     const int end = std::min(total, begin + options.batch_exposures);
     const RoadPlane prior = running->plane();
     ParallelFor(end - begin, threads, [&](int k) {
+      cancel.ThrowIfCancelled();  // between exposures
       results[begin + k] =
           ProcessExposure(survey, exposures[begin + k], pairs, options, prior,
                           options.search.slab_half_thickness_m,
@@ -486,7 +488,7 @@ void AppendVertices(const std::vector<Exposure>& exposures,
 ReconstructionSummary ReconstructSurvey(
     const Survey& survey, const ReconstructionOptions& options,
     std::vector<ReconstructedVertex>* vertices,
-    const ProgressCallback& progress) {
+    const ProgressCallback& progress, const CancellationToken& cancel) {
   const Clock::time_point wall_start = Clock::now();
   ReconstructionSummary summary;
   summary.message = options.Check();
@@ -521,8 +523,8 @@ ReconstructionSummary ReconstructSurvey(
   summary.initial_road_plane = initial;
   pairs = MakePairs(rig, initial, options, &summary);
   RoadPlaneTracker running(initial, options.search);
-  const std::vector<ExposureResult> results =
-      ProcessExposures(survey, pairs, options, threads, progress, &running);
+  const std::vector<ExposureResult> results = ProcessExposures(
+      survey, pairs, options, threads, progress, cancel, &running);
   summary.final_road_plane = running.plane();
   AppendVertices(exposures, results, pairs, &summary, vertices);
   summary.wall_time_s = SecondsSince(wall_start);

@@ -42,6 +42,7 @@
 #include "reconstruction/road_rectification.h"
 #include "reconstruction/search_volume.h"
 #include "reconstruction/subpixel_edges.h"
+#include "survey/cancellation.h"
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/survey.h"
@@ -184,7 +185,8 @@ using ProgressCallback = std::function<void(int, int)>;
 ReconstructionSummary ReconstructSurvey(
     const Survey& survey, const ReconstructionOptions& options,
     std::vector<ReconstructedVertex>* vertices,
-    const ProgressCallback& progress = nullptr);
+    const ProgressCallback& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

@@ -429,7 +429,8 @@ std::string RoadLineSummary::BriefReport() const {
 RoadLineSummary ExtractSurveyLines(
     const Survey& survey, const RoadPlane& road, const RoadLineOptions& options,
     int threads, std::vector<ReconstructedLinePoint>* points,
-    const std::function<void(int, int)>& progress) {
+    const std::function<void(int, int)>& progress,
+    const CancellationToken& cancel) {
   RoadLineSummary summary;
   const Rig& rig = survey.rig;
   std::vector<std::unique_ptr<StereoLineExtractor>> extractors;
@@ -457,6 +458,7 @@ RoadLineSummary ExtractSurveyLines(
   }
   PrepareImageCodecs();  // before the worker threads read images
   ParallelFor(total, threads, [&](int e) {
+    cancel.ThrowIfCancelled();  // between exposures
     const Exposure& exposure = exposures[e];
     results[e].resize(extractors.size());
     ran[e].assign(extractors.size(), false);

@@ -55,6 +55,7 @@
 #include "reconstruction/bright_lines.h"
 #include "reconstruction/crossing_edges.h"
 #include "reconstruction/road_rectification.h"
+#include "survey/cancellation.h"
 #include "survey/results_lines.h"
 #include "survey/rig.h"
 #include "survey/survey.h"
@@ -261,7 +262,8 @@ struct RoadLineSummary {
 RoadLineSummary ExtractSurveyLines(
     const Survey& survey, const RoadPlane& road, const RoadLineOptions& options,
     int threads, std::vector<ReconstructedLinePoint>* points,
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

@@ -15,11 +15,11 @@
 namespace zebrageo {
 namespace {
 
-using band_matcher_internal::Fixed;
 using band_matcher_internal::MatchState;
 
 MatchResult RunSteps(const MatchInput& input, const MatchOptions& options,
-                     const std::function<void(int, int)>& progress) {
+                     const std::function<void(int, int)>& progress,
+                     const CancellationToken& cancel) {
   namespace internal = band_matcher_internal;
   const auto start = std::chrono::steady_clock::now();
   MatchState state(input, options);
@@ -34,6 +34,7 @@ MatchResult RunSteps(const MatchInput& input, const MatchOptions& options,
   state.unbeaten_offsets.assign(n, {});
   state.evidence.assign(n, ObservationEvidence());
   for (int o = 0; o < n; ++o) {
+    cancel.ThrowIfCancelled();
     const CrossingObservation& source = input.observations[o];
     ObservationEvidence& ev = state.evidence[o];
     ev.exposure_id = source.exposure_id;
@@ -121,35 +122,6 @@ std::string MatchOptions::Check() const {
   return check.problem();
 }
 
-const char* FaultKindName(FaultKind kind) {
-  switch (kind) {
-    case FaultKind::kCrossingMissingFromDatabase:
-      return "crossing_missing_from_database";
-    case FaultKind::kCrossingGoneFromStreet:
-      return "crossing_gone_from_street";
-    case FaultKind::kBandMissingFromStreet:
-      return "band_missing_from_street";
-    case FaultKind::kBandMissingFromDatabase:
-      return "band_missing_from_database";
-    case FaultKind::kCrossingShifted:
-      return "crossing_shifted";
-  }
-  return "unknown";
-}
-
-std::string MatchSummary::BriefReport() const {
-  std::ostringstream out;
-  if (!IsUsable()) return "match: not run: " + message;
-  out << "match: " << observations << " observations: " << matched
-      << " matched (" << resolved_by_neighbours << " by continuity), "
-      << refused << " refused (" << ambiguous << " ambiguous, " << inconsistent
-      << " inconsistent), " << no_candidate << " without candidate; "
-      << vertex_matches << " vertex matches on " << crossings_matched
-      << " crossings; " << faults << " database faults; " << Fixed(seconds, 2)
-      << " s";
-  return out.str();
-}
-
 Eigen::Vector3d CorrectedEnu(const Pose& measured,
                              const PoseCorrection& correction,
                              const Eigen::Vector3d& p_body) {
@@ -158,7 +130,8 @@ Eigen::Vector3d CorrectedEnu(const Pose& measured,
 }
 
 MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
-                       const std::function<void(int, int)>& progress) {
+                       const std::function<void(int, int)>& progress,
+                       const CancellationToken& cancel) {
   MatchResult result;
   const std::string problem = options.Check();
   if (!problem.empty()) {
@@ -169,7 +142,7 @@ MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
     result.summary.message = "MatchInput: no road-mark index";
     return result;
   }
-  result = RunSteps(input, options, progress);
+  result = RunSteps(input, options, progress, cancel);
   LOG(INFO) << result.summary.BriefReport();
   return result;
 }

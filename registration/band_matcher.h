@@ -61,7 +61,9 @@
 
 #include "registration/paint_probe.h"
 #include "registration/roadmark_index.h"
+#include "survey/cancellation.h"
 #include "survey/results.h"
+#include "survey/results_match.h"
 #include "survey/rig.h"
 #include "survey/trajectory.h"
 
@@ -257,14 +259,6 @@ struct MatchOptions {
   }
 };
 
-// A horizontal correction of the measured pose at one exposure (see the
-// header comment): p_true = Rz(heading_rad) (p - p_vehicle) + p_vehicle +
-// shift_enu_m.
-struct PoseCorrection {
-  double heading_rad = 0.0;
-  Eigen::Vector2d shift_enu_m = Eigen::Vector2d::Zero();
-};
-
 // One reconstructed band of an observation.
 struct ObservedBand {
   int64_t band_id = 0;
@@ -311,89 +305,13 @@ struct MatchInput {
       paint_probe;
 };
 
-enum class FaultKind {
-  kCrossingMissingFromDatabase,
-  kCrossingGoneFromStreet,
-  kBandMissingFromStreet,
-  kBandMissingFromDatabase,
-  kCrossingShifted,
-};
-const char* FaultKindName(FaultKind kind);  // e.g. "crossing_gone_from_street"
-
-struct DatabaseFault {
-  FaultKind kind = FaultKind::kCrossingGoneFromStreet;
-  std::string crossing_id;  // empty for a crossing missing from the database
-  int band = 0;             // band faults: the band (or the one beyond)
-  Eigen::Vector2d location_enu = Eigen::Vector2d::Zero();
-  double shift_m = 0.0;  // kCrossingShifted
-  int views = 0;         // exposures behind the finding
-  std::vector<int64_t> exposure_ids;
-  std::string description;
-};
-
-// Why one observation was decided as it was.
-struct ObservationEvidence {
-  int64_t exposure_id = 0;
-  int64_t group_id = 0;
-  double time_s = 0.0;
-  Decision decision = Decision::kNoCandidate;
-  std::string crossing_id;
-  std::string reason;
-  int bands = 0;         // observed bands
-  int usable_bands = 0;  // with a zebra band's shape and 4 vertices
-  int candidate_db_bands = 0;
-  int hypotheses = 0;
-  // Of the chosen (or best) hypothesis, in this observation alone:
-  int hits = 0;
-  int missing = 0;
-  int contradictions = 0;
-  int unexplained = 0;
-  double own_score = 0.0;
-  // Over the window:
-  double aggregated_score = 0.0;
-  bool has_runner_up = false;
-  double runner_up_score = 0.0;
-  double robust_margin = 0.0;     // the margin the decision used
-  double both_ends_margin = 0.0;  // without the stronger end's evidence
-  std::string runner_up;  // what the runner-up is ("band offset +1", ...)
-  bool resolved_by_neighbours = false;
-  PoseCorrection correction;
-  double vertex_rms_m = 0.0;
-  int vertex_matches = 0;
-  std::vector<int> matched_bands;  // database band numbers
-};
-
-struct MatchSummary {
-  int observations = 0;
-  int matched = 0;
-  int refused = 0;
-  int no_candidate = 0;
-  int ambiguous = 0;               // refused as ambiguous
-  int inconsistent = 0;            // refused by the continuity check
-  int resolved_by_neighbours = 0;  // matched thanks to continuity
-  int vertex_matches = 0;
-  int crossings_matched = 0;
-  int faults = 0;
-  double seconds = 0.0;
-  // Empty when the matcher ran; otherwise why not (bad options, no index).
-  std::string message;
-
-  bool IsUsable() const { return message.empty(); }
-  std::string BriefReport() const;
-};
-
-struct MatchResult {
-  std::vector<VertexMatch> matches;
-  std::vector<CrossingDecision> decisions;    // one per observation, in order
-  std::vector<ObservationEvidence> evidence;  // one per observation, in order
-  std::vector<DatabaseFault> faults;
-  MatchSummary summary;
-};
-
 // Matches every observation. Deterministic. `progress` (may be empty) is
 // called with (done, total) observations.
+// Throws CancelledError when `cancel` is cancelled (checked between
+// observations).
 MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
-                       const std::function<void(int, int)>& progress = {});
+                       const std::function<void(int, int)>& progress = {},
+                       const CancellationToken& cancel = {});
 
 // The ENU position of a body-frame point under a measured pose corrected by
 // `correction` (horizontal only).

@@ -22,15 +22,6 @@ namespace {
 // Gaps listed one by one in the warnings before "and N more".
 constexpr int kMaxListedGaps = 3;
 
-// Text of a number for messages, with `decimals` decimals.
-std::string Fixed(double value, int decimals) {
-  std::ostringstream text;
-  text.setf(std::ios::fixed);
-  text.precision(decimals);
-  text << value;
-  return text.str();
-}
-
 // A sample interval for messages: 3 significant digits ("0.01", "0.2").
 std::string Interval(double seconds) {
   std::ostringstream text;
@@ -41,12 +32,13 @@ std::string Interval(double seconds) {
 
 // "850 m" or "6012 km" (message text).
 std::string Distance(double metres) {
-  if (metres < 10e3) return Fixed(metres, 0) + " m";
-  return Fixed(metres / 1e3, 0) + " km";
+  if (metres < 10e3) return FormatFixed(metres, 0) + " m";
+  return FormatFixed(metres / 1e3, 0) + " km";
 }
 
 std::string LatLon(const Geodetic& g) {
-  return "(" + Fixed(g.lat_deg, 6) + ", " + Fixed(g.lon_deg, 6) + ")";
+  return "(" + FormatFixed(g.lat_deg, 6) + ", " + FormatFixed(g.lon_deg, 6) +
+         ")";
 }
 
 double GeodesicDistance(const Geodetic& a, const Geodetic& b) {
@@ -194,14 +186,14 @@ void CheckHeading(const PlausibilityInput& input,
         "columns 'roll', 'pitch', 'heading' look like radians, not degrees: "
         "read as degrees, the heading differs from the direction of travel "
         "by " +
-            Fixed(RadToDeg(d.median_as_degrees_rad), 1) +
+            FormatFixed(RadToDeg(d.median_as_degrees_rad), 1) +
             " deg, read as radians by " +
-            Fixed(RadToDeg(d.median_as_radians_rad), 1) + " deg" + where);
+            FormatFixed(RadToDeg(d.median_as_radians_rad), 1) + " deg" + where);
   }
   throw InputError(
       file, 0,
       "column 'heading' differs from the direction of travel by " +
-          Fixed(RadToDeg(d.median_as_degrees_rad), 1) + " deg" + where +
+          FormatFixed(RadToDeg(d.median_as_degrees_rad), 1) + " deg" + where +
           ", more than max_heading_disagreement_deg = " +
           FormatDouble(options.max_heading_disagreement_deg) +
           ": the heading must be degrees clockwise from true north of the "
@@ -398,7 +390,7 @@ void CheckRate(const PlausibilityInput& input,
   // 5% slack: time stamps rounded to the millisecond.
   if (!(interval > 1.05 / options.min_rate_hz)) return;
   warnings->push_back(
-      input.trajectory_file + ": " + Fixed(1.0 / interval, 1) +
+      input.trajectory_file + ": " + FormatFixed(1.0 / interval, 1) +
       " Hz (median sample interval " + Interval(interval) +
       " s) is below the " + FormatDouble(options.min_rate_hz) +
       " Hz the survey format asks for: poses are interpolated over " +
@@ -408,7 +400,7 @@ void CheckRate(const PlausibilityInput& input,
 
 std::string GapText(const TrajectoryGap& gap,
                     const std::vector<TrajectorySample>& samples) {
-  return Fixed(gap.duration(), 2) +
+  return FormatFixed(gap.duration(), 2) +
          " s with no sample (t = " + FormatDouble(gap.start_time) +
          " on line " + std::to_string(samples[gap.before].line) + " to " +
          FormatDouble(gap.end_time) + " on line " +

@@ -11,6 +11,7 @@
 #include "survey/input_error.h"
 #include "survey/math_util.h"
 #include "survey/option_check.h"
+#include "survey/output_crs.h"
 
 namespace zebrageo {
 namespace {
@@ -221,10 +222,12 @@ std::vector<TrajectorySample> ParseTrajectorySamples(
 }
 
 void WriteTrajectorySamples(const std::vector<TrajectorySample>& samples,
-                            const std::string& path) {
+                            const std::string& path, const OutputCrs* crs) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     CsvWriter csv(&out);
-    csv.Header(TrajectoryColumns());
+    std::vector<std::string> columns = TrajectoryColumns();
+    if (crs != nullptr) crs->AddHeader(&csv, &columns);
+    csv.Header(columns);
     for (const TrajectorySample& s : samples) {
       double heading = std::fmod(RadToDeg(s.attitude.heading), 360.0);
       if (heading < 0.0) heading += 360.0;
@@ -242,6 +245,7 @@ void WriteTrajectorySamples(const std::vector<TrajectorySample>& samples,
           .Add(RadToDeg(s.sd_attitude_rad.x()))
           .Add(RadToDeg(s.sd_attitude_rad.y()))
           .Add(RadToDeg(s.sd_attitude_rad.z()));
+      if (crs != nullptr) crs->AddColumns(s.position, &csv);
       csv.EndRow();
     }
   });

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "survey/cancellation.h"
 #include "survey/exposures.h"
 #include "survey/math_util.h"
 #include "survey/rig.h"
@@ -87,7 +88,8 @@ std::vector<TieTrack> BuildTieTracks(
     const TiePointOptions& options, const std::string& survey_folder,
     const Rig& rig, const Trajectory& trajectory,
     const ExposureTable& exposures, TiePointSummary* summary,
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

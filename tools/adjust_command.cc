@@ -1,15 +1,18 @@
 // `zebrageo adjust SURVEY -o RESULTS`: reads reconstructed_bands.csv and
-// matches.csv, adjusts the trajectory (pipeline/stages.h) and writes
+// matches.csv, adjusts the trajectory (pipeline/adjust_stage.h) and writes
 // trajectory_corrected.csv, poses.csv, gcp_residuals.csv, bands.geojson,
-// adjustment.json, a minimal report.json and colmap/.
+// adjustment.json and colmap/, then the report (report.json, report.html).
+#include <chrono>
 #include <memory>
 
+#include "pipeline/adjust_stage.h"
 #include "pipeline/exit_codes.h"
+#include "pipeline/report_stage.h"
 #include "pipeline/results_session.h"
-#include "pipeline/stages.h"
+#include "pipeline/run_options.h"
 #include "survey/math_util.h"
 #include "tools/commands.h"
-#include "tools/progress.h"
+#include "tools/progress_bars.h"
 
 namespace zebrageo {
 namespace {
@@ -19,16 +22,18 @@ struct AdjustArguments {
   bool tie_points = true;
   bool lines = true;
   bool self_calibrate = false;
-  double check_share = AdjustmentOptions().control.check_crossing_share;
-  int threads = AdjustmentOptions().solver.num_threads;
+  double check_share = RunOptions().adjustment.control.check_crossing_share;
+  int threads = RunOptions().adjustment.solver.num_threads;
   double sideslip_sigma_deg =
-      RadToDeg(AdjustmentOptions().vehicle_motion.sideslip_sigma_rad);
+      RadToDeg(RunOptions().adjustment.vehicle_motion.sideslip_sigma_rad);
 };
 
 void RunAdjust(const AdjustArguments& args) {
   RunOptions options;
   options.tie_points = args.tie_points;
   options.lines = args.lines;
+  // The second registration pass is `zebrageo match --second-pass`.
+  options.rematch = false;
   AdjustmentOptions& adjustment = options.adjustment;
   adjustment.control.check_crossing_share = args.check_share;
   adjustment.rig_calibration.self_calibrate_rig = args.self_calibrate;
@@ -46,7 +51,18 @@ void RunAdjust(const AdjustArguments& args) {
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
   session.Open();
   StageResults results(args.stage.results);
-  RunAdjustStage(survey, &results, options, ProgressBars());
+  const auto start = std::chrono::steady_clock::now();
+  ReportInputs inputs;
+  inputs.warnings = RunAdjustStage(survey, &results, options, ProgressBars(),
+                                   CancelOnSignal());
+  inputs.timings = {
+      {"adjust",
+       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+           .count(),
+       false}};
+  inputs.survey = &survey;
+  inputs.results_folder = args.stage.results;
+  RunReportStage(inputs, options.report);
   session.Succeeded();
 }
 

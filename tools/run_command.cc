@@ -7,14 +7,14 @@
 
 #include "pipeline/exit_codes.h"
 #include "pipeline/pipeline.h"
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 #include "pipeline/results_session.h"
 #include "pipeline/run_options.h"
 #include "survey/math_util.h"
 #include "survey/results.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/progress.h"
+#include "tools/progress_bars.h"
 
 namespace zebrageo {
 namespace {
@@ -82,6 +82,7 @@ void Run(const RunArguments& args) {
   RunContext context;
   context.progress = ProgressBars();
   context.from_stage = args.from_stage;
+  context.cancel = CancelOnSignal();
   const RunSummary run =
       RunSurveyPipeline(survey, args.stage.results, options, context);
   for (const auto& warning : run.report["warnings"]) {
@@ -169,7 +170,7 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
                          ReportInputs inputs;
                          inputs.survey = &survey;
                          inputs.results_folder = report_args->results;
-                         WriteReport(inputs, ReportOptions());
+                         RunReportStage(inputs, ReportOptions());
                          session.Succeeded();
                          std::cout << "report: " << report_args->results << "/"
                                    << kReportHtmlFile << "\n";

@@ -92,9 +92,7 @@ TEST(AttitudeSignificance, ZeroDisablesTheTest) {
 TEST(AttitudeSignificance, NegativeThresholdIsRejectedByCheck) {
   AdjustmentOptions options;
   options.model.attitude_significance = -1.0;
-  EXPECT_EQ(options.Check(),
-            "attitude_significance = -1: must be finite and >= 0 (0 "
-            "disables)");
+  EXPECT_EQ(options.Check(), "model.attitude_significance = -1: must be >= 0");
 }
 
 }  // namespace

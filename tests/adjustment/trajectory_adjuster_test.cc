@@ -7,7 +7,6 @@
 #include <iostream>
 #include <set>
 
-#include "adjustment/adjustment_io.h"
 #include "survey/input_error.h"
 #include "tests/adjustment/pose_errors.h"
 #include "tests/support/synthetic_survey.h"
@@ -374,67 +373,14 @@ TEST(AdjustmentOptions, CheckNamesFieldValueAndConstraint) {
   AdjustmentOptions options;
   EXPECT_EQ(options.Check(), "");
   options.control.check_crossing_share = 1.0;
-  EXPECT_EQ(options.Check(), "check_crossing_share = 1: must be in [0, 1)");
+  EXPECT_EQ(options.Check(),
+            "control.check_crossing_share = 1: must be in [0, 1)");
   options = AdjustmentOptions();
   options.solver.num_threads = 0;
   EXPECT_EQ(options.Check(), "solver.num_threads = 0: must be >= 1");
   options = AdjustmentOptions();
   options.control.vertex_sigma_px = 0.0;
-  EXPECT_EQ(options.Check(), "vertex_sigma_px = 0: must be finite and > 0");
-}
-
-TEST(AdjustmentIo, WritesEveryContractOutputReadableByTheSurveyReaders) {
-  SyntheticSurveyOptions options = KilometreOptions();
-  options.num_exposures = 120;
-  const SyntheticSurvey survey = MakeSyntheticSurvey(options);
-  TemporaryFolder folder;
-  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
-  const AdjustmentData data =
-      LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
-  EXPECT_EQ(data.missing_images,
-            static_cast<int>(survey.exposures.images.size()));
-  const AdjustmentOptions adjustment_options;
-  const AdjustmentResult result =
-      AdjustTrajectory(adjustment_options, data.Input());
-  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
-  WriteAdjustmentResults(data, adjustment_options, result, nullptr,
-                         folder.Path("results"));
-  const auto poses =
-      ReadCameraPoses(folder.Path("results/poses.csv"), "poses.csv");
-  EXPECT_EQ(poses.size(), survey.exposures.images.size());
-  const auto samples = ReadTrajectorySamples(
-      folder.Path("results/trajectory_corrected.csv"), "trajectory_corrected");
-  ASSERT_EQ(samples.size(), survey.measured_samples.size());
-  for (size_t i = 0; i < samples.size(); ++i) {
-    ASSERT_EQ(samples[i].time, survey.measured_samples[i].time);
-  }
-  const auto gcps = ReadGcpResiduals(folder.Path("results/gcp_residuals.csv"),
-                                     "gcp_residuals.csv");
-  EXPECT_EQ(gcps.size(), result.control_points.size());
-  EXPECT_FALSE(
-      ReadAdjustedBands(folder.Path("results/bands.geojson"), "bands.geojson")
-          .empty());
-  for (const char* name :
-       {"adjustment.json", "report.json", "colmap/cameras.txt",
-        "colmap/images.txt", "colmap/points3D.txt"}) {
-    EXPECT_TRUE(std::filesystem::is_regular_file(
-        folder.Path(std::string("results/") + name)))
-        << name;
-  }
-}
-
-TEST(AdjustmentIo, MissingStageOutputsNameTheStageToRun) {
-  const SyntheticSurvey survey = MakeSyntheticSurvey(KilometreOptions());
-  TemporaryFolder folder;
-  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
-  std::filesystem::remove(folder.Path("results/matches.csv"));
-  try {
-    LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
-    FAIL() << "expected an InputError";
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("zebrageo match"),
-              std::string::npos);
-  }
+  EXPECT_EQ(options.Check(), "control.vertex_sigma_px = 0: must be > 0");
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// MatchLinesForAdjustment against a simulated survey's truth: a vehicle
+// The road lines registered to the database (registration/
+// line_registration.h) against a simulated survey's truth: a vehicle
 // driving east between painted lane lines, the reconstructed line points
 // exactly where the true trajectory puts them, one database line drawn
 // 25 cm away from its paint (repainted).
@@ -10,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/stages.h"
+#include "pipeline/adjustment_pass.h"
+#include "registration/line_registration.h"
 #include "survey/results_lines.h"
 #include "tests/survey/test_util.h"
 
@@ -18,6 +20,33 @@ namespace zebrageo {
 namespace {
 
 using ::testing::HasSubstr;
+
+// The registration on `zebra`'s trajectory, its files written into
+// `folder` as the adjust stage writes them (nothing when it is "").
+std::vector<LineControlPoint> MatchLinesForAdjustment(
+    const AdjustmentData& data, const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration, const AdjustmentResult& zebra,
+    const std::vector<ReconstructedLinePoint>* points,
+    const std::string& folder, std::vector<std::string>* warnings) {
+  if (points == nullptr) return {};
+  LineRegistrationInput input;
+  input.roadmarks = &data.roadmarks;
+  input.frame = &data.frame;
+  input.exposures = &data.exposures;
+  input.vertices = &data.vertices;
+  input.matches = &data.matches;
+  input.trajectory = {&zebra.corrected_samples, &zebra.corrected_poses,
+                      zebra.summary.corrected};
+  input.min_database_sigma_m = options.control.min_database_sigma_m;
+  LineRegistration lines = RegisterRoadLines(*points, input, registration);
+  warnings->insert(warnings->end(), lines.warnings.begin(),
+                   lines.warnings.end());
+  if (!folder.empty() && lines.record) {
+    WriteLineMatches(lines.rows, folder + "/" + kLineMatchesFile);
+    WriteLineControl(*lines.record, folder + "/" + kLineControlFile);
+  }
+  return lines.control;
+}
 
 constexpr double kSpeedMps = 10.0;
 constexpr double kCameraHeightM = 2.0;

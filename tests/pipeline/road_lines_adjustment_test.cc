@@ -1,5 +1,5 @@
-// AdjustByRoadLinesAlone (pipeline/stages.h): the trajectory the road lines
-// alone correct, on which the second registration pass searches when the
+// AdjustByRoadLinesAlone (pipeline/adjustment_pass.h): the trajectory the road
+// lines alone correct, on which the second registration pass searches when the
 // adjustment had too few crossings. A synthetic survey drifting by a metre,
 // two lane lines painted along its true path and drawn so in the database,
 // their points reconstructed ideally from the true poses.
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/stages.h"
+#include "pipeline/adjustment_pass.h"
 #include "tests/support/synthetic_survey.h"
 
 namespace zebrageo {

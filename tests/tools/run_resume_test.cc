@@ -189,6 +189,43 @@ TEST_F(RunResume, KilledDuringAdjustThenRerunGivesTheSameResults) {
   KillDuringStageThenRerun("adjust", std::chrono::milliseconds(50));
 }
 
+// SIGINT while the adjust stage runs: the run stops at its next checkpoint
+// (between solves), exits 6 ("cancelled"), leaves no file half-written and
+// none of the stage's outputs; the rerun resumes to the reference results.
+TEST_F(RunResume, CancelledDuringAdjustThenRerunGivesTheSameResults) {
+  const std::string results = folder_->Path("cancelled");
+  const pid_t pid =
+      Spawn({"--log-level", "error", "run", survey_, "-o", results});
+  ASSERT_GT(pid, 0);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(300);
+  while (!StageInProgress(results, "adjust") &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+  ASSERT_EQ(WEXITSTATUS(status), 6) << "the run ended before the cancel";
+  ASSERT_TRUE(StageInProgress(results, "adjust"));
+  for (const std::string& file : FilesUnder(results)) {
+    EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+  }
+  for (const char* file :
+       {"trajectory_corrected.csv", "poses.csv", "gcp_residuals.csv",
+        "bands.geojson", "adjustment.json", "report.json"}) {
+    EXPECT_FALSE(fs::exists(results + "/" + file)) << file;
+  }
+  const std::string err = folder_->Path("cancelled.err");
+  ASSERT_EQ(RunZebrageo("run " + Quote(survey_) + " -o " + Quote(results),
+                        folder_->Path("cancelled.out"), err),
+            0)
+      << ReadWholeFile(err);
+  ExpectSameResults(reference_, results);
+}
+
 // The stages report.json lists as resumed.
 std::vector<std::string> ResumedStages(const std::string& results) {
   const json report = json::parse(ReadWholeFile(results + "/report.json"));

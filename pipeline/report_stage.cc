@@ -1,4 +1,4 @@
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 
 #include <glog/logging.h>
 
@@ -17,9 +17,11 @@
 #include "pipeline/version.h"
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
 #include "survey/option_check.h"
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
+#include "survey/results_report.h"
 
 namespace zebrageo {
 using report_internal::Collect;
@@ -39,13 +41,6 @@ std::vector<std::string> WithoutRepeats(const std::vector<std::string>& texts) {
     if (seen.insert(text).second) unique.push_back(text);
   }
   return unique;
-}
-
-double Rms(const std::vector<double>& values) {
-  if (values.empty()) return 0.0;
-  double sum = 0.0;
-  for (double v : values) sum += v * v;
-  return std::sqrt(sum / values.size());
 }
 
 json GcpStatistics(const ReportData& data, GcpRole role) {
@@ -411,7 +406,7 @@ std::string RenderReportHtml(const json& report, const ReportInputs& inputs) {
   return RenderHtml(report, Collect(inputs));
 }
 
-json WriteReport(const ReportInputs& inputs, const ReportOptions& options) {
+json RunReportStage(const ReportInputs& inputs, const ReportOptions& options) {
   CHECK(inputs.survey != nullptr);
   const std::string error = options.Check();
   if (!error.empty()) throw std::invalid_argument("ReportOptions: " + error);
@@ -420,8 +415,7 @@ json WriteReport(const ReportInputs& inputs, const ReportOptions& options) {
   const std::string html = RenderHtml(report, data);
   const std::string folder = inputs.results_folder + "/";
   WriteReportJson(report, folder + kReportJsonFile);
-  WriteFileAtomically(folder + kReportHtmlFile,
-                      [&](std::ostream& out) { out << html; });
+  WriteReportHtml(html, folder + kReportHtmlFile);
   return report;
 }
 
