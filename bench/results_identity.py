@@ -18,7 +18,8 @@ BASELINE is main's binary before the change (a refactor must not change a
 number); the surveys are simulated with BASELINE into DIR/surveys once, and
 BASELINE's results are kept in DIR/<binary id>/ and reused. Besides `run`,
 the demo also goes through the stage commands one by one (reconstruct
---lines, match, adjust). Exit status 0 when every folder matches, 1 if not.
+--lines, match, adjust, report). Exit status 0 when every folder matches,
+1 if not.
 """
 
 import argparse
@@ -211,7 +212,11 @@ def surveys(work, baseline, only):
 
 # The stage commands one by one, on the demo (`run` does the same in one
 # process, through the same stages).
-STAGE_COMMANDS = [["reconstruct", "--lines"], ["match"], ["adjust"]]
+# `report` last: since issue 44 `adjust` writes the whole report (one writer
+# for report.json) where it wrote a brief one before; after `report` both
+# binaries' folders hold the whole report.
+STAGE_COMMANDS = [["reconstruct", "--lines"], ["match"], ["adjust"],
+                  ["report"]]
 
 
 def run_all(binary, name, survey, out_root):
