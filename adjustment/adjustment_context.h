@@ -26,6 +26,8 @@ struct Context {
   const AdjustmentInput& input;
   DejumpedTrajectory dejumped;
   AdjustmentSummary* summary;
+  // Checked between solves and the solver's iterations.
+  CancellationToken cancel;
 
   void Warn(const std::string& warning) const {
     LogAdjustmentWarning(options, warning);

@@ -115,8 +115,9 @@ CrossingTable AddControlPoints(const Context& context, State* state) {
           std::min(crossings.first_time[p.crossing], t->second);
       p.database_enu = input.frame->EnuFromGeodetic(band.corners[m.db_vertex]);
       const double sxy =
-          std::max(band.sigma_xy_m, options.min_database_sigma_m);
-      const double sz = std::max(band.sigma_z_m, options.min_database_sigma_m);
+          std::max(band.sigma_xy_m, options.control.min_database_sigma_m);
+      const double sz =
+          std::max(band.sigma_z_m, options.control.min_database_sigma_m);
       p.sigma_m = Eigen::Vector3d(sxy, sxy, sz);
       p.estimate = p.database_enu;
       state->points.push_back(p);

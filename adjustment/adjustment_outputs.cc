@@ -303,8 +303,8 @@ void FillControlPoints(const OutputContext& context, State* state,
   MarkHeldOutAsChecks(state, &summary);
   // What the database alone puts into a check residual, per the model the
   // adjustment uses for it: the vertex sigma and the crossing offset.
-  const double offset_variance =
-      options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
+  const double offset_variance = options.control.crossing_offset_sigma_m *
+                                 options.control.crossing_offset_sigma_m;
   ControlResiduals residuals;
   for (const ControlPoint& p : state->points) {
     bool triangulated = false;

@@ -21,12 +21,14 @@ AdjustmentProblem::AdjustmentProblem(const AdjustmentOptions& options,
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_ = std::make_unique<ceres::Problem>(problem_options);
   if (robust) {
-    image_loss_ = std::make_unique<ceres::HuberLoss>(options.image_loss_scale);
+    image_loss_ =
+        std::make_unique<ceres::HuberLoss>(options.control.image_loss_scale);
     control_loss_ =
-        std::make_unique<ceres::CauchyLoss>(options.control_loss_scale);
-    line_loss_ = std::make_unique<ceres::CauchyLoss>(options.line_loss_scale);
-    motion_loss_ =
-        std::make_unique<ceres::CauchyLoss>(options.vehicle_motion_loss_scale);
+        std::make_unique<ceres::CauchyLoss>(options.control.control_loss_scale);
+    line_loss_ =
+        std::make_unique<ceres::CauchyLoss>(options.road_lines.line_loss_scale);
+    motion_loss_ = std::make_unique<ceres::CauchyLoss>(
+        options.vehicle_motion.vehicle_motion_loss_scale);
   }
   AddKnotPriors();
   AddExposureOffsets();
@@ -36,9 +38,31 @@ AdjustmentProblem::AdjustmentProblem(const AdjustmentOptions& options,
   AddVehicleMotion();
 }
 
-ceres::Solver::Summary AdjustmentProblem::Solve() {
+namespace {
+
+// Ends the solve between iterations once the run is cancelled.
+class CancelCallback : public ceres::IterationCallback {
+ public:
+  explicit CancelCallback(const CancellationToken& cancel) : cancel_(cancel) {}
+  ceres::CallbackReturnType operator()(
+      const ceres::IterationSummary&) override {
+    return cancel_.IsCancelled() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const CancellationToken& cancel_;
+};
+
+}  // namespace
+
+ceres::Solver::Summary AdjustmentProblem::Solve(
+    const CancellationToken& cancel) {
   ceres::Solver::Options solver_options =
       ToCeresOptions(options_.solver, num_pose_blocks_);
+  CancelCallback cancel_callback(cancel);
+  if (cancel.flag() != nullptr) {
+    solver_options.callbacks.push_back(&cancel_callback);
+  }
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (ControlPoint& p : state_->points) {
     if (p.status == ControlStatus::kControl) {
@@ -116,15 +140,16 @@ void AdjustmentProblem::AddImageResidual(
   std::vector<double*> blocks = {knots[first].data(), knots[first + 1].data(),
                                  knots[first + 2].data(),
                                  knots[first + 3].data(), point};
-  if (options_.self_calibrate_rig) {
+  if (options_.rig_calibration.self_calibrate_rig) {
     blocks.push_back(state_->rig_corrections[o.camera].data());
   }
-  ids->push_back(AddWithExposure(
-      SplineReprojectionCost::Create(
-          o.uv, Eigen::Matrix2d::Identity() / sigma_px, w, o.ins_pose,
-          state_->correction.Frame(o.ins_pose), camera.T_body_cam,
-          camera.camera.intrinsics(), options_.self_calibrate_rig),
-      image_loss_.get(), blocks, o.exposure));
+  ids->push_back(
+      AddWithExposure(SplineReprojectionCost::Create(
+                          o.uv, Eigen::Matrix2d::Identity() / sigma_px, w,
+                          o.ins_pose, state_->correction.Frame(o.ins_pose),
+                          camera.T_body_cam, camera.camera.intrinsics(),
+                          options_.rig_calibration.self_calibrate_rig),
+                      image_loss_.get(), blocks, o.exposure));
 }
 
 ceres::ResidualBlockId AdjustmentProblem::AddWithExposure(
@@ -238,12 +263,14 @@ void AdjustmentProblem::HoldAxes() {
 
 void AdjustmentProblem::AddRigPriors() {
   // Rig mounting: parameters only when self-calibrating.
-  if (!options_.self_calibrate_rig) return;
+  if (!options_.rig_calibration.self_calibrate_rig) return;
   for (auto& r : state_->rig_corrections) {
     problem_->AddParameterBlock(r.data(), kRigCorrectionSize);
     Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();
-    S.diagonal().head<3>().setConstant(1.0 / options_.boresight_sigma_rad);
-    S.diagonal().tail<3>().setConstant(1.0 / options_.lever_arm_sigma_m);
+    S.diagonal().head<3>().setConstant(
+        1.0 / options_.rig_calibration.boresight_sigma_rad);
+    S.diagonal().tail<3>().setConstant(
+        1.0 / options_.rig_calibration.lever_arm_sigma_m);
     problem_->AddResidualBlock(LinearPrior<1, 6>::Create(S, {1.0}), nullptr,
                                r.data());
     ++num_pose_blocks_;
@@ -259,13 +286,14 @@ void AdjustmentProblem::AddControl() {
     if (!offset_used[p.crossing]) {
       offset_used[p.crossing] = 1;
       problem_->AddParameterBlock(offset, 3);
-      if (options_.crossing_offset_sigma_m > 0.0) {
+      if (options_.control.crossing_offset_sigma_m > 0.0) {
         // Robust: a crossing far from where the database has it (a wrong
         // match, a repainted crossing) moves its own offset, not the
         // trajectory; the blunder test then rejects it.
         problem_->AddResidualBlock(
             LinearPrior<1, 3>::Create(
-                Eigen::Matrix3d::Identity() / options_.crossing_offset_sigma_m,
+                Eigen::Matrix3d::Identity() /
+                    options_.control.crossing_offset_sigma_m,
                 {1.0}),
             control_loss_.get(), offset);
         ++num_pose_blocks_;
@@ -277,9 +305,9 @@ void AdjustmentProblem::AddControl() {
     blocks_.control_priors.push_back(problem_->AddResidualBlock(
         PointPriorError::Create(p.database_enu, S), control_loss_.get(),
         p.estimate.data(), offset));
-    if (options_.self_calibrate_rig) {
+    if (options_.rig_calibration.self_calibrate_rig) {
       for (const ImageObservation& o : p.observations) {
-        AddImageResidual(o, p.estimate.data(), options_.vertex_sigma_px,
+        AddImageResidual(o, p.estimate.data(), options_.control.vertex_sigma_px,
                          &blocks_.control_images);
       }
       continue;
@@ -340,12 +368,13 @@ void AdjustmentProblem::AddVehicleMotion() {
   // misalignment shares the prior, and tightens with it (as measured).
   const double misalignment_sigma_rad =
       state_->along_track_held
-          ? std::min(options_.vehicle_misalignment_sigma_rad,
-                     options_.lines_only_misalignment_sigma_rad)
-          : options_.vehicle_misalignment_sigma_rad;
+          ? std::min(options_.vehicle_motion.vehicle_misalignment_sigma_rad,
+                     options_.vehicle_motion.lines_only_misalignment_sigma_rad)
+          : options_.vehicle_motion.vehicle_misalignment_sigma_rad;
   const double misalignment = 1.0 / misalignment_sigma_rad;
   const Eigen::Matrix3d S =
-      Eigen::Vector3d(misalignment, 1.0 / options_.axle_offset_sigma_m,
+      Eigen::Vector3d(misalignment,
+                      1.0 / options_.vehicle_motion.axle_offset_sigma_m,
                       misalignment)
           .asDiagonal();
   problem_->AddResidualBlock(LinearPrior<1, kVehicleSize>::Create(S, {1.0}),

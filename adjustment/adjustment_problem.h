@@ -40,7 +40,9 @@ class AdjustmentProblem {
   ceres::Problem* problem() { return problem_.get(); }
   const Blocks& blocks() const { return blocks_; }
 
-  ceres::Solver::Summary Solve();
+  // Stops between iterations once `cancel` is cancelled (the summary then
+  // says so; the caller throws).
+  ceres::Solver::Summary Solve(const CancellationToken& cancel = {});
 
   // sqrt(sum r^2 / (residuals - free parameters)), without loss functions.
   double Sigma0();

@@ -41,18 +41,19 @@ Eigen::Vector2d ChooseVehicleMotion(const Context& context, State* state) {
   for (const TrajectorySample& sample : trajectory.samples()) {
     sample_times.push_back(sample.time);
   }
-  const Eigen::Vector2d stated(options.sideslip_sigma_rad,
-                               options.vertical_slip_sigma_rad);
+  const Eigen::Vector2d stated(options.vehicle_motion.sideslip_sigma_rad,
+                               options.vehicle_motion.vertical_slip_sigma_rad);
   double best_information = 0.0;
   Eigen::Vector2d best_sigma = stated;
   std::vector<VehicleMotionSample> best;
   for (double factor : {1.0, 2.0, 5.0, 10.0, 20.0}) {
-    const double half_chord = factor * options.vehicle_motion_half_chord_s;
-    const double rate =
-        std::min(options.vehicle_motion_rate_hz, 1.0 / (2.0 * half_chord));
+    const double half_chord =
+        factor * options.vehicle_motion.vehicle_motion_half_chord_s;
+    const double rate = std::min(options.vehicle_motion.vehicle_motion_rate_hz,
+                                 1.0 / (2.0 * half_chord));
     std::vector<VehicleMotionSample> samples = MakeVehicleMotionSamples(
         state->correction, sample_times, rate, half_chord,
-        options.vehicle_motion_min_speed_mps, stated,
+        options.vehicle_motion.vehicle_motion_min_speed_mps, stated,
         [&context](double time, Pose* pose) {
           return context.InsPoseAt(time, pose);
         });
@@ -61,8 +62,8 @@ Eigen::Vector2d ChooseVehicleMotion(const Context& context, State* state) {
         samples, state->correction, std::max(1.0, 10.0 * half_chord));
     // Constraints closer than the sideslip's correlation time are not
     // independent: each counts for its share of that time.
-    const double shared =
-        std::sqrt(std::max(1.0, rate * options.vehicle_motion_correlation_s));
+    const double shared = std::sqrt(std::max(
+        1.0, rate * options.vehicle_motion.vehicle_motion_correlation_s));
     const Eigen::Vector2d sigma = shared * spread.cwiseMax(stated);
     const double information = rate / (sigma.x() * sigma.x());
     VLOG(1) << "vehicle motion: half chord " << half_chord << " s, "
@@ -119,12 +120,12 @@ double PositionSigma(const AdjustmentOptions& options,
     ++n;
   }
   if (n == 0 || chi_square <= ChiSquare95(dof)) {
-    return options.min_position_sigma_m;
+    return options.model.min_position_sigma_m;
   }
   constexpr double kNoShrinkFactor = 3.0;
   return std::clamp(
       std::max(likelihood_sigma, kNoShrinkFactor * std::sqrt(sum_square / n)),
-      options.min_position_sigma_m, options.max_position_sigma_m);
+      options.model.min_position_sigma_m, options.model.max_position_sigma_m);
 }
 
 // With zebra control and road lines: the lines measure the error across
@@ -138,8 +139,8 @@ double PositionSigma(const AdjustmentOptions& options,
 void WidenByLines(const AdjustmentOptions& options, const State& state,
                   ErrorModel* model) {
   const std::vector<CrossingDiscrepancy> seen =
-      LineDiscrepancies(state, options.line_discrepancy_bin_s,
-                        options.line_discrepancy_min_points);
+      LineDiscrepancies(state, options.road_lines.line_discrepancy_bin_s,
+                        options.road_lines.line_discrepancy_min_points);
   if (seen.empty()) return;
   const std::vector<bool> all(seen.size(), true);
   const std::vector<GaussMarkovFit> fits =
@@ -147,18 +148,19 @@ void WidenByLines(const AdjustmentOptions& options, const State& state,
   for (int axis = 1; axis < 3; ++axis) {
     // Where the crossings show a drift, their fit stands (the lines'
     // discrepancies hold the database lines' own errors too).
-    if (model->position_sigma_m[axis] > options.min_position_sigma_m) continue;
+    if (model->position_sigma_m[axis] > options.model.min_position_sigma_m)
+      continue;
     const double level =
         PositionSigma(options, seen, all, axis, fits[axis].sigma);
     // The exposures' jitter, modelled on its own, is in the lines' too.
     const double jitter = model->jitter_sigma_m[axis];
     const double sigma =
-        level > options.min_position_sigma_m
+        level > options.model.min_position_sigma_m
             ? std::max(
-                  options.min_position_sigma_m,
+                  options.model.min_position_sigma_m,
                   std::sqrt(std::max(0.0, fits[axis].sigma * fits[axis].sigma -
                                               jitter * jitter)))
-            : options.min_position_sigma_m;
+            : options.model.min_position_sigma_m;
     VLOG(1) << "error model axis " << axis << ": crossings "
             << model->position_sigma_m[axis] << " m, road lines " << sigma
             << " m (level " << level << " m)";
@@ -200,7 +202,7 @@ void SetKnotPriors(const Context& context, const DejumpedTrajectory& dejumped,
       extra += Eigen::Vector3d::Constant(dejumped.innovation_variance_m2[j]);
       // In ENU (track_frame false) the cross-track axis is no axis.
       const double across = dejumped.cross_track_innovation_variance_m2[j];
-      if (options.track_frame) {
+      if (options.model.track_frame) {
         extra.y() += across;
       } else {
         extra += Eigen::Vector3d::Constant(across);
@@ -214,14 +216,14 @@ void SetKnotPriors(const Context& context, const DejumpedTrajectory& dejumped,
 void InitialiseCorrection(const Context& context, State* state) {
   const AdjustmentOptions& options = context.options;
   const Trajectory& trajectory = *context.input.trajectory;
-  state->correction =
-      TrajectoryCorrection(trajectory.start_time(), trajectory.end_time(),
-                           options.knot_spacing_s, options.track_frame);
+  state->correction = TrajectoryCorrection(
+      trajectory.start_time(), trajectory.end_time(),
+      options.model.knot_spacing_s, options.model.track_frame);
   state->rig_corrections.assign(context.input.rig->cameras.size(),
                                 std::array<double, kRigCorrectionSize>{});
   context.summary->num_knots = state->correction.num_knots();
   SetKnotPriors(context, context.dejumped, state);
-  if (options.sideslip_sigma_rad > 0.0) {
+  if (options.vehicle_motion.sideslip_sigma_rad > 0.0) {
     state->model.motion_sigma_rad = ChooseVehicleMotion(context, state);
   }
   context.summary->num_vehicle_motion = static_cast<int>(state->motion.size());
@@ -243,17 +245,18 @@ void FitPositionModel(const Context& context,
   // error model is fitted on what they show across them and in height.
   std::vector<CrossingDiscrepancy> lines;
   if (RoadLinesOnly(options, state)) {
-    lines = LineDiscrepancies(state, options.line_discrepancy_bin_s,
-                              options.line_discrepancy_min_points);
+    lines = LineDiscrepancies(state, options.road_lines.line_discrepancy_bin_s,
+                              options.road_lines.line_discrepancy_min_points);
     use.assign(lines.size(), true);
   }
   const std::vector<CrossingDiscrepancy>& d = lines.empty() ? crossings : lines;
   for (int axis = 0; axis < 3; ++axis) {
-    model.position_sigma_m[axis] = std::clamp(1.0, options.min_position_sigma_m,
-                                              options.max_position_sigma_m);
-    model.position_tau_s[axis] = options.position_tau_s;
+    model.position_sigma_m[axis] =
+        std::clamp(1.0, options.model.min_position_sigma_m,
+                   options.model.max_position_sigma_m);
+    model.position_tau_s[axis] = options.model.position_tau_s;
   }
-  if (options.estimate_position_model) {
+  if (options.model.estimate_position_model) {
     const std::vector<GaussMarkovFit> fits =
         adjustment_internal::FitAxes(d, use, PositionFitOptions(options));
     for (int axis = 0; axis < 3; ++axis) {
@@ -261,15 +264,15 @@ void FitPositionModel(const Context& context,
           PositionSigma(options, d, use, axis, fits[axis].sigma);
       // The variation about that level: the likelihood's, where the
       // control shows a drift at all.
-      model.position_sigma_m[axis] =
-          model.position_level_sigma_m[axis] > options.min_position_sigma_m
-              ? fits[axis].sigma
-              : options.min_position_sigma_m;
+      model.position_sigma_m[axis] = model.position_level_sigma_m[axis] >
+                                             options.model.min_position_sigma_m
+                                         ? fits[axis].sigma
+                                         : options.model.min_position_sigma_m;
       model.position_tau_s[axis] = fits[axis].tau_s;
     }
   }
   if (lines.empty() && !state.lines.empty() &&
-      options.estimate_position_model) {
+      options.model.estimate_position_model) {
     WidenByLines(options, state, &model);
   }
   if (!lines.empty()) {
@@ -295,19 +298,20 @@ ErrorModel InitialErrorModel(const Context& context,
   }
   for (int axis = 0; axis < 3; ++axis) {
     model.attitude_sigma_rad[axis] =
-        std::clamp(Median(sd[axis]), options.min_attitude_sigma_rad,
-                   options.max_attitude_sigma_rad);
-    model.attitude_tau_s[axis] = options.attitude_tau_s;
+        std::clamp(Median(sd[axis]), options.model.min_attitude_sigma_rad,
+                   options.model.max_attitude_sigma_rad);
+    model.attitude_tau_s[axis] = options.model.attitude_tau_s;
   }
   model.motion_sigma_rad = state.model.motion_sigma_rad;
-  model.tie_sigma_px = options.tie_sigma_px;
+  model.tie_sigma_px = options.tie_points.tie_sigma_px;
   std::vector<double> times;
   for (const TrajectorySample& sample : context.input.trajectory->samples()) {
     times.push_back(sample.time);
   }
-  const PositionJitter jitter = EstimatePositionJitter(
-      times, context.dejumped.poses, options.jitter_window_s, 0.1);
-  if (jitter.sigma_m.maxCoeff() > options.min_jitter_m) {
+  const PositionJitter jitter =
+      EstimatePositionJitter(times, context.dejumped.poses,
+                             options.trajectory_faults.jitter_window_s, 0.1);
+  if (jitter.sigma_m.maxCoeff() > options.trajectory_faults.min_jitter_m) {
     model.jitter_sigma_m = jitter.sigma_m;
     model.jitter_tau_s = jitter.tau_s;
     context.Warn(
@@ -330,7 +334,8 @@ ErrorModel InitialErrorModel(const Context& context,
 }
 
 bool RoadLinesOnly(const AdjustmentOptions& options, const State& state) {
-  return options.line_control_without_crossings && !state.lines.empty() &&
+  return options.road_lines.line_control_without_crossings &&
+         !state.lines.empty() &&
          std::none_of(state.points.begin(), state.points.end(),
                       [](const ControlPoint& p) {
                         return p.status != ControlStatus::kRejected;

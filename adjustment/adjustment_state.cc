@@ -29,10 +29,10 @@ Eigen::Matrix<double, 6, 1> ErrorModel::Tau() const {
 
 Eigen::Vector3d State::PriorJumpAt(double time) const {
   if (knot_prior.empty()) return Eigen::Vector3d::Zero();
-  const int k = std::clamp(
-      static_cast<int>(std::lround((time - correction.KnotTime(0)) /
-                                   correction.knot_spacing())),
-      0, static_cast<int>(knot_prior.size()) - 1);
+  const int k =
+      std::clamp(static_cast<int>(std::lround((time - correction.KnotTime(0)) /
+                                              correction.knot_spacing())),
+                 0, static_cast<int>(knot_prior.size()) - 1);
   return knot_prior[k].tail<3>();
 }
 
@@ -95,9 +95,10 @@ Pose CorrectedPose(const State& state, double time, const Pose& ins_pose,
 
 Eigen::Matrix3d ObservationCovariance(const AdjustmentOptions& options,
                                       const StereoObservation& o) {
-  Eigen::Matrix3d C = options.stereo_covariance_scale * o.covariance_body;
+  Eigen::Matrix3d C =
+      options.control.stereo_covariance_scale * o.covariance_body;
   C.diagonal().array() +=
-      options.min_stereo_sigma_m * options.min_stereo_sigma_m;
+      options.control.min_stereo_sigma_m * options.control.min_stereo_sigma_m;
   return C;
 }
 
@@ -205,8 +206,8 @@ StateRms MeasureState(const Rig& rig, const State& state) {
 void EvaluateControlPoints(const AdjustmentOptions& options, const Rig& rig,
                            State* state) {
   (void)rig;
-  const double floor2 =
-      options.blunder_sigma_floor_m * options.blunder_sigma_floor_m;
+  const double floor2 = options.blunders.blunder_sigma_floor_m *
+                        options.blunders.blunder_sigma_floor_m;
   for (ControlPoint& p : state->points) {
     Eigen::Matrix3d covariance;
     Eigen::Vector3d X;
@@ -221,8 +222,8 @@ void EvaluateControlPoints(const AdjustmentOptions& options, const Rig& rig,
     if (p.status == ControlStatus::kControl) {
       reference += state->crossing_offsets[p.crossing];
     } else {
-      sigma.diagonal().array() +=
-          options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
+      sigma.diagonal().array() += options.control.crossing_offset_sigma_m *
+                                  options.control.crossing_offset_sigma_m;
     }
     const Eigen::Vector3d d = X - reference;
     const double w2 = d.dot(sigma.ldlt().solve(d));

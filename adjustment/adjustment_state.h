@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "adjustment/cost_functions.h"
-#include "adjustment/line_control.h"
+#include "adjustment/line_costs.h"
 #include "adjustment/trajectory_adjuster.h"
 #include "adjustment/trajectory_correction.h"
 #include "adjustment/vehicle_motion.h"

@@ -20,8 +20,8 @@ bool AttitudeSignificance(const Context& context, const State& state,
   const AdjustmentOptions& options = context.options;
   const auto& knots = state.correction.knots();
   const int n = static_cast<int>(knots.size());
-  if (problem == nullptr || !options.compute_covariance ||
-      n > options.max_knots_for_covariance) {
+  if (problem == nullptr || !options.covariance.compute_covariance ||
+      n > options.covariance.max_knots_for_covariance) {
     return false;
   }
   ceres::Covariance::Options covariance_options;
@@ -53,7 +53,7 @@ bool AttitudeSignificance(const Context& context, const State& state,
 
 bool HoldInsignificantAttitude(const Context& context, State* state,
                                AdjustmentProblem* problem) {
-  const double threshold = context.options.attitude_significance;
+  const double threshold = context.options.model.attitude_significance;
   if (threshold <= 0.0) return false;
   // One crossing, seen on one approach, measures the heading only together
   // with the rate of the cross-track drift (both turn its bands the same

@@ -21,7 +21,7 @@ bool AdjustmentSolver::Adjust() {
   // Least squares first (the drift makes every observation look like an
   // outlier at the start), then robustly.
   if (!SolveTwice()) return false;
-  for (int iteration = 0; iteration < options.max_blunder_iterations;
+  for (int iteration = 0; iteration < options.blunders.max_blunder_iterations;
        ++iteration) {
     if (!RejectBlunders()) break;
     if (!HasControl()) {
@@ -53,9 +53,12 @@ bool AdjustmentSolver::HasControl() const {
 
 bool AdjustmentSolver::Solve(bool robust) {
   AdjustmentSummary& summary = *context_.summary;
+  context_.cancel.ThrowIfCancelled();
   problem_ = std::make_unique<AdjustmentProblem>(
       context_.options, *context_.input.rig, robust, state_);
-  const ceres::Solver::Summary s = problem_->Solve();
+  const ceres::Solver::Summary s = problem_->Solve(context_.cancel);
+  // A solve the cancellation stopped is no result.
+  context_.cancel.ThrowIfCancelled();
   ++summary.solves;
   summary.iterations += static_cast<int>(s.iterations.size()) - 1;
   summary.num_residuals = s.num_residuals;
@@ -81,10 +84,10 @@ bool AdjustmentSolver::RejectBlunders() {
   }
   // A whole crossing off: its estimated offset against the offset prior.
   std::vector<double> crossing_w(num_crossings, 0.0);
-  if (options.crossing_offset_sigma_m > 0.0) {
+  if (options.control.crossing_offset_sigma_m > 0.0) {
     for (int c = 0; c < num_crossings; ++c) {
-      crossing_w[c] =
-          state.crossing_offsets[c].norm() / options.crossing_offset_sigma_m;
+      crossing_w[c] = state.crossing_offsets[c].norm() /
+                      options.control.crossing_offset_sigma_m;
     }
   }
   for (const ControlPoint& p : state.points) {
@@ -98,10 +101,10 @@ bool AdjustmentSolver::RejectBlunders() {
             << state.crossing_offsets[c].transpose() << " (" << crossing_w[c]
             << " sigma)";
   }
-  if (worst <= options.blunder_threshold) return false;
+  if (worst <= options.blunders.blunder_threshold) return false;
   for (ControlPoint& p : state.points) {
     if (p.status == ControlStatus::kControl &&
-        crossing_w[p.crossing] > options.blunder_threshold &&
+        crossing_w[p.crossing] > options.blunders.blunder_threshold &&
         crossing_w[p.crossing] >= 0.5 * worst) {
       p.status = ControlStatus::kRejected;
       p.normalized_residual =
@@ -114,7 +117,7 @@ bool AdjustmentSolver::RejectBlunders() {
   for (ControlPoint& p : state.points) {
     if (p.status != ControlStatus::kControl) continue;
     ++control_in[p.crossing];
-    if (p.normalized_residual > options.blunder_threshold &&
+    if (p.normalized_residual > options.blunders.blunder_threshold &&
         p.normalized_residual >= 0.5 * worst) {
       p.status = ControlStatus::kRejected;
       ++rejected_in[p.crossing];
@@ -123,7 +126,7 @@ bool AdjustmentSolver::RejectBlunders() {
   for (ControlPoint& p : state.points) {
     if (p.status == ControlStatus::kControl &&
         rejected_in[p.crossing] >
-            options.reject_crossing_share * control_in[p.crossing]) {
+            options.blunders.reject_crossing_share * control_in[p.crossing]) {
       p.status = ControlStatus::kRejected;
     }
   }
@@ -165,8 +168,8 @@ bool RunAdjustments(const Context& context, State* state,
   // and in height (the error model is then fitted on them,
   // line_discrepancies.h); ties and the vehicle's motion are relative.
   // Without either the input trajectory is kept.
-  const bool line_control =
-      options.line_control_without_crossings && !state->lines.empty();
+  const bool line_control = options.road_lines.line_control_without_crossings &&
+                            !state->lines.empty();
   if (!solver->HasControl() && !any_check && !line_control) {
     *why_not = "no control point (no matched band vertex)";
     return false;
@@ -180,13 +183,13 @@ bool RunAdjustments(const Context& context, State* state,
     ResetState(state);
     adjusted = solver->Adjust();
   }
-  if (adjusted && any_check && options.check_points_in_final) {
+  if (adjusted && any_check && options.control.check_points_in_final) {
     HoldOutCheckPoints(context, state);
     ResetState(state);
     adjusted = solver->Adjust();
   }
-  if (adjusted && options.estimate_variance_components) {
-    for (int i = 0; i < options.max_variance_iterations; ++i) {
+  if (adjusted && options.model.estimate_variance_components) {
+    for (int i = 0; i < options.model.max_variance_iterations; ++i) {
       if (!UpdateVarianceComponents(options, solver->problem(), state,
                                     &summary.warnings)) {
         break;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "adjustment/line_discrepancies.h"
+#include "survey/csv.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
@@ -17,12 +18,6 @@ namespace {
 // Above this many crossings the leave-one-out test keeps the error model
 // fitted on all of them (a refit per crossing would cost n^4).
 constexpr int kMaxCrossingsForRefit = 40;
-
-std::string Fixed(double value, int decimals) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(decimals) << value;
-  return out.str();
-}
 
 // -log of the upper tail probability of a chi-square of `dof` (1 to 3)
 // degrees of freedom at `x`: crossings tested on different numbers of axes
@@ -158,8 +153,8 @@ std::vector<CrossingDiscrepancy> Witnesses(const AdjustmentOptions& options,
                                            const State& state) {
   std::vector<CrossingDiscrepancy> witnesses = DashDiscrepancies(state);
   for (CrossingDiscrepancy d :
-       LineDiscrepancies(state, options.line_discrepancy_bin_s,
-                         options.line_discrepancy_min_points)) {
+       LineDiscrepancies(state, options.road_lines.line_discrepancy_bin_s,
+                         options.road_lines.line_discrepancy_min_points)) {
     d.variance_m2[2] = kUnmeasuredVarianceM2;
     if (d.variance_m2[1] < kUnmeasuredVarianceM2) witnesses.push_back(d);
   }
@@ -201,8 +196,8 @@ std::vector<CrossingDiscrepancy> CrossingDiscrepancies(
     }
   }
   std::vector<CrossingDiscrepancy> out(n);
-  const double offset2 =
-      options.crossing_offset_sigma_m * options.crossing_offset_sigma_m;
+  const double offset2 = options.control.crossing_offset_sigma_m *
+                         options.control.crossing_offset_sigma_m;
   for (int c = 0; c < n; ++c) {
     const int m = static_cast<int>(values[c].size());
     if (m == 0) continue;
@@ -345,22 +340,23 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
     const Eigen::Vector3d& d = crossings[worst].value_m;
     verdict.reason =
         "crossing " + names[worst] +
-        " implies a trajectory correction (along-track " + Fixed(d.x(), 2) +
-        " m, cross-track " + Fixed(d.y(), 2) + " m, up " + Fixed(d.z(), 2) +
-        " m) that " + (count > 1 ? "the other crossings, " : "") +
+        " implies a trajectory correction (along-track " +
+        FormatFixed(d.x(), 2) + " m, cross-track " + FormatFixed(d.y(), 2) +
+        " m, up " + FormatFixed(d.z(), 2) + " m) that " +
+        (count > 1 ? "the other crossings, " : "") +
         (voting.empty() ? std::string()
          : count > 1    ? "the road lines (across the track; whole "
                           "lane-line dashes along it), "
                         : "the road lines across the track, ") +
         "and the GNSS/INS error model do not explain (chi-square " +
-        Fixed(worst_chi, 1) + " > " + Fixed(threshold, 1) +
+        FormatFixed(worst_chi, 1) + " > " + FormatFixed(threshold, 1) +
         (worst_dof == 3   ? std::string()
          : worst_dof == 1 ? " on the one axis they measure"
                           : " on the two axes they measure") +
         ")";
     if (verdict.one_period_off) {
       verdict.reason += "; shifted by one band period (" +
-                        Fixed(period.norm(), 2) +
+                        FormatFixed(period.norm(), 2) +
                         " m) it would fit: matched one band off";
     } else {
       verdict.reason += ": repainted, or wrongly matched";
@@ -372,10 +368,10 @@ std::vector<CrossingVerdict> SelectConsistentCrossings(
 
 GaussMarkovFitOptions PositionFitOptions(const AdjustmentOptions& options) {
   GaussMarkovFitOptions fit;
-  fit.min_sigma = options.min_position_sigma_m;
-  fit.max_sigma = options.max_position_sigma_m;
-  fit.default_tau_s = options.position_tau_s;
-  fit.min_samples_for_tau = options.min_crossings_for_tau;
+  fit.min_sigma = options.model.min_position_sigma_m;
+  fit.max_sigma = options.model.max_position_sigma_m;
+  fit.default_tau_s = options.model.position_tau_s;
+  fit.min_samples_for_tau = options.model.min_crossings_for_tau;
   return fit;
 }
 
@@ -386,8 +382,8 @@ void RejectInconsistentCrossings(const Context& context,
   const std::vector<CrossingVerdict> verdicts =
       adjustment_internal::SelectConsistentCrossings(
           d, crossings.names, PositionFitOptions(context.options),
-          context.options.crossing_consistency_chi_square,
-          context.options.two_crossings_position_sigma_m,
+          context.options.selection.crossing_consistency_chi_square,
+          context.options.selection.two_crossings_position_sigma_m,
           Witnesses(context.options, *state));
   for (size_t c = 0; c < verdicts.size(); ++c) {
     if (verdicts[c].consistent) continue;
@@ -413,16 +409,16 @@ void MarkCheckCrossings(const Context& context, const CrossingTable& crossings,
   for (int c = 0; c < num_crossings; ++c) {
     if (usable[c]) order.push_back(c);
   }
-  if (options.check_crossing_share <= 0.0 || order.empty()) return;
+  if (options.control.check_crossing_share <= 0.0 || order.empty()) return;
   std::sort(order.begin(), order.end(), [&](int a, int b) {
     return crossings.first_time[a] < crossings.first_time[b];
   });
-  const int k = std::max(
-      2, static_cast<int>(std::lround(1.0 / options.check_crossing_share)));
+  const int k = std::max(2, static_cast<int>(std::lround(
+                                1.0 / options.control.check_crossing_share)));
   std::vector<int> checks;
   for (size_t i = k / 2; i < order.size(); i += k) checks.push_back(order[i]);
   if (static_cast<int>(order.size() - checks.size()) <
-      options.min_control_crossings) {
+      options.control.min_control_crossings) {
     if (!checks.empty()) {
       context.Warn("only " + std::to_string(order.size()) +
                    " crossings matched: none held out as check points, the "

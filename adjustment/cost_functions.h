@@ -6,7 +6,7 @@
 //                           priors on the knots and the exposures' offsets
 //   exposure_offset_cost.h  an exposure's jitter offset added to a residual
 //   vehicle_motion.h        the vehicle moves along its heading
-//   line_control.h          road-line points on database lines
+//   line_costs.h            road-line points on database lines
 // Frames: ENU (the survey's working frame), body (FRD), camera (OpenCV).
 // Knot blocks are [dtheta (rad, ENU rotation vector), dp (m, ENU)] of
 // trajectory_correction.h; rotation vectors are applied with

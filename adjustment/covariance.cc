@@ -17,8 +17,9 @@ std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
   const AdjustmentOptions& options = context.options;
   const Trajectory& trajectory = *context.input.trajectory;
   std::vector<Eigen::Matrix3d> sample_covariance;
-  if (problem == nullptr || !options.compute_covariance ||
-      state->correction.num_knots() > options.max_knots_for_covariance) {
+  if (problem == nullptr || !options.covariance.compute_covariance ||
+      state->correction.num_knots() >
+          options.covariance.max_knots_for_covariance) {
     return sample_covariance;
   }
   ceres::Covariance::Options covariance_options;

@@ -7,6 +7,9 @@
 #include <limits>
 #include <sstream>
 
+#include "survey/math_util.h"
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -35,8 +38,7 @@ double LogLikelihood(const ProcessSamples& s, double sigma, double tau_s) {
   const Eigen::VectorXd w = llt.matrixL().solve(y);
   double log_det = 0.0;
   for (int i = 0; i < n; ++i) log_det += 2.0 * std::log(llt.matrixL()(i, i));
-  return -0.5 * w.squaredNorm() - 0.5 * log_det -
-         0.5 * n * std::log(2.0 * 3.14159265358979323846);
+  return -0.5 * w.squaredNorm() - 0.5 * log_det - 0.5 * n * std::log(2.0 * kPi);
 }
 
 // The sigma in [min, max] of the largest likelihood at `tau_s`: golden
@@ -92,24 +94,17 @@ ProcessSamples ProcessSamples::Without(int i) const {
 }
 
 std::string GaussMarkovFitOptions::Check() const {
-  std::ostringstream out;
-  if (!(min_sigma > 0.0) || !(max_sigma >= min_sigma) ||
-      !std::isfinite(max_sigma)) {
-    out << "min_sigma = " << min_sigma << ", max_sigma = " << max_sigma
-        << ": need 0 < min_sigma <= max_sigma";
-  } else if (!(default_tau_s > 0.0) || !std::isfinite(default_tau_s)) {
-    out << "default_tau_s = " << default_tau_s << ": must be > 0";
-  } else if (tau_grid_s.empty()) {
-    out << "tau_grid_s: must not be empty";
-  } else {
-    for (double tau : tau_grid_s) {
-      if (!(tau > 0.0) || !std::isfinite(tau)) {
-        out << "tau_grid_s holds " << tau << ": every tau must be > 0";
-        break;
-      }
-    }
+  OptionCheck check;
+  OPTION_GT(check, min_sigma, 0.0);
+  OPTION_GE(check, max_sigma, min_sigma);
+  OPTION_GT(check, default_tau_s, 0.0);
+  check.Require(!tau_grid_s.empty(), "tau_grid_s", std::string("[]"),
+                "must not be empty");
+  for (double tau : tau_grid_s) {
+    check.Require(tau > 0.0 && std::isfinite(tau), "tau_grid_s[]", tau,
+                  "every tau must be > 0");
   }
-  return out.str();
+  return check.problem();
 }
 
 GaussMarkovFit FitGaussMarkov(const ProcessSamples& samples,

@@ -47,6 +47,16 @@ struct NeverWorseOptions {
 
   // "" when valid, else "field = value: constraint".
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("outage_min_jump_m", outage_min_jump_m);
+    v("outage_min_length_s", outage_min_length_s);
+    v("outage_max_length_s", outage_max_length_s);
+    v("gnss_return_decay_s", gnss_return_decay_s);
+    v("guard_sigmas", guard_sigmas);
+    v("guard_min_difference_m", guard_min_difference_m);
+    v("guard_crossing_sigma_m", guard_crossing_sigma_m);
+  }
 };
 
 }  // namespace zebrageo

@@ -79,8 +79,8 @@ Score ScoreOf(const Context& context, const CrossingTable& crossings,
       PooledWitnesses(ControlWitnesses(options, state), kWitnessBinS);
   const std::vector<CrossingVerdict> verdicts = SelectConsistentCrossings(
       d, crossings.names, PositionFitOptions(options),
-      options.crossing_consistency_chi_square,
-      options.two_crossings_position_sigma_m, witnesses);
+      options.selection.crossing_consistency_chi_square,
+      options.selection.two_crossings_position_sigma_m, witnesses);
   Score score;
   std::vector<bool> kept(d.size(), false);
   for (size_t c = 0; c < d.size(); ++c) {

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -16,47 +18,21 @@ std::string Violation(const char* field, T value, const char* constraint) {
 }  // namespace
 
 std::string SolverOptions::Check() const {
-  if (max_dense_pose_blocks < 0) {
-    return Violation("max_dense_pose_blocks", max_dense_pose_blocks,
-                     "must be >= 0");
-  }
-  if (max_sparse_pose_blocks < max_dense_pose_blocks) {
-    return Violation("max_sparse_pose_blocks", max_sparse_pose_blocks,
-                     "must be >= max_dense_pose_blocks");
-  }
-  if (num_threads < 1) {
-    return Violation("num_threads", num_threads, "must be >= 1");
-  }
-  if (max_num_iterations < 0) {
-    return Violation("max_num_iterations", max_num_iterations, "must be >= 0");
-  }
-  if (!(function_tolerance >= 0.0)) {
-    return Violation("function_tolerance", function_tolerance, "must be >= 0");
-  }
-  if (!(gradient_tolerance >= 0.0)) {
-    return Violation("gradient_tolerance", gradient_tolerance, "must be >= 0");
-  }
-  if (!(parameter_tolerance >= 0.0)) {
-    return Violation("parameter_tolerance", parameter_tolerance,
-                     "must be >= 0");
-  }
-  if (!(max_solver_time_in_seconds > 0.0)) {
-    return Violation("max_solver_time_in_seconds", max_solver_time_in_seconds,
-                     "must be > 0");
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GE(check, max_dense_pose_blocks, 0);
+  OPTION_GE(check, max_sparse_pose_blocks, max_dense_pose_blocks);
+  OPTION_GE(check, num_threads, 1);
+  OPTION_GE(check, max_num_iterations, 0);
+  OPTION_GE(check, function_tolerance, 0.0);
+  OPTION_GE(check, gradient_tolerance, 0.0);
+  OPTION_GE(check, parameter_tolerance, 0.0);
+  OPTION_GT(check, max_solver_time_in_seconds, 0.0);
+  return check.problem();
 }
 
 const char* LinearSolverName(LinearSolver solver) {
-  switch (solver) {
-    case LinearSolver::kAuto:
-      return "auto";
-    case LinearSolver::kDenseSchur:
-      return "DENSE_SCHUR";
-    case LinearSolver::kSparseSchur:
-      return "SPARSE_SCHUR";
-    case LinearSolver::kIterativeSchur:
-      return "ITERATIVE_SCHUR";
+  for (const auto& [value, name] : kLinearSolverNames) {
+    if (value == solver) return name;
   }
   return "?";
 }

@@ -9,6 +9,8 @@
 #include <ceres/solver.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace zebrageo {
 
@@ -18,6 +20,13 @@ enum class LinearSolver {
   kSparseSchur,     // SuiteSparse Cholesky of the reduced camera system
   kIterativeSchur,  // conjugate gradients, Schur-Jacobi preconditioner
 };
+
+// LinearSolver's names (options files, adjustment.json).
+inline const std::vector<std::pair<LinearSolver, const char*>>
+    kLinearSolverNames = {{LinearSolver::kAuto, "auto"},
+                          {LinearSolver::kDenseSchur, "DENSE_SCHUR"},
+                          {LinearSolver::kSparseSchur, "SPARSE_SCHUR"},
+                          {LinearSolver::kIterativeSchur, "ITERATIVE_SCHUR"}};
 
 struct SolverOptions {
   LinearSolver linear_solver = LinearSolver::kAuto;
@@ -41,6 +50,19 @@ struct SolverOptions {
 
   // "" when valid, else "field = value: constraint".
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("linear_solver", linear_solver, kLinearSolverNames);
+    v("max_dense_pose_blocks", max_dense_pose_blocks);
+    v("max_sparse_pose_blocks", max_sparse_pose_blocks);
+    v("num_threads", num_threads);
+    v("max_num_iterations", max_num_iterations);
+    v("function_tolerance", function_tolerance);
+    v("gradient_tolerance", gradient_tolerance);
+    v("parameter_tolerance", parameter_tolerance);
+    v("max_solver_time_in_seconds", max_solver_time_in_seconds);
+    v("minimizer_progress_to_stdout", minimizer_progress_to_stdout);
+  }
 };
 
 // The Ceres options for a problem with `num_pose_blocks` camera/pose

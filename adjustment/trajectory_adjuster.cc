@@ -32,15 +32,10 @@
 #include "adjustment/input_guard.h"
 #include "adjustment/outage_model.h"
 #include "adjustment/trajectory_jumps.h"
+#include "survey/csv.h"
 
 namespace zebrageo {
 namespace {
-
-std::string FixedText(double value, int decimals) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(decimals) << value;
-  return out.str();
-}
 
 using adjustment_internal::AdjustmentSolver;
 using adjustment_internal::Context;
@@ -116,9 +111,10 @@ void SelectControl(const Context& context, const CrossingTable& crossings,
 
 }  // namespace
 
-AdjustmentResult AdjustTrajectory(
-    const AdjustmentOptions& options, const AdjustmentInput& input,
-    const std::function<void(int, int)>& progress) {
+AdjustmentResult AdjustTrajectory(const AdjustmentOptions& options,
+                                  const AdjustmentInput& input,
+                                  const std::function<void(int, int)>& progress,
+                                  const CancellationToken& cancel) {
   const auto start = std::chrono::steady_clock::now();
   AdjustmentResult result;
   AdjustmentSummary& summary = result.summary;
@@ -128,17 +124,18 @@ AdjustmentResult AdjustTrajectory(
   // The INS trajectory the correction applies to: without its jumps.
   Context context{
       options, input,
-      RemoveJumps(*input.trajectory, options.jump_threshold_m,
-                  options.jump_threshold_rad, options.sideways_switches),
-      &summary};
+      RemoveJumps(*input.trajectory, options.trajectory_faults.jump_threshold_m,
+                  options.trajectory_faults.jump_threshold_rad,
+                  options.trajectory_faults.sideways_switches),
+      &summary, cancel};
   summary.num_jumps = context.dejumped.num_jumps;
   for (const SidewaysSwitch& s : context.dejumped.switches) {
     const std::vector<TrajectorySample>& samples = input.trajectory->samples();
     context.Warn(
-        "the GNSS/INS positions move " + FixedText(std::abs(s.size_m), 2) +
+        "the GNSS/INS positions move " + FormatFixed(std::abs(s.size_m), 2) +
         " m " + (s.size_m > 0.0 ? "right" : "left") +
-        " of the heading from time " + FixedText(samples[s.first].time, 2) +
-        " to " + FixedText(samples[s.last].time, 2) +
+        " of the heading from time " + FormatFixed(samples[s.first].time, 2) +
+        " to " + FormatFixed(samples[s.last].time, 2) +
         ": a switch of the GNSS error (multipath?), corrected as "
         "continuous INS motion");
   }

@@ -137,31 +137,19 @@ void SpreadOutageClosures(const Trajectory& trajectory,
   }
 }
 
-DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
-                               double threshold_rad,
-                               const SidewaysSwitchOptions& switches) {
+namespace {
+
+// Each step's departure from its neighbours' motion: of the position
+// (metres) and of the rotation (radians, body frame), per sample (zero at
+// the first).
+struct StepDepartures {
+  std::vector<Eigen::Vector3d> position;
+  std::vector<Eigen::Vector3d> rotation;
+};
+StepDepartures DepartureOfEachStep(const Trajectory& trajectory) {
   const std::vector<Pose>& poses = trajectory.poses();
-  const int n = static_cast<int>(poses.size());
-  DejumpedTrajectory out;
-  out.poses = poses;
-  out.position_offset.assign(n, Eigen::Vector3d::Zero());
-  out.rotation_offset.assign(n, Eigen::Quaterniond::Identity());
-  std::vector<Eigen::Vector3d> sideways;
-  if (n < 8 || (threshold_m <= 0.0 && threshold_rad <= 0.0)) {
-    out.switches = FindSidewaysSwitches(trajectory, switches, {}, &sideways);
-    Eigen::Vector3d position_jump = Eigen::Vector3d::Zero();
-    out.switch_step.assign(n, false);
-    for (int i = 1; i < n; ++i) {
-      out.switch_step[i] = !sideways[i].isZero();
-      position_jump += sideways[i];
-      out.position_offset[i] = position_jump;
-      out.poses[i].p_enu = poses[i].p_enu - position_jump;
-    }
-    SpreadOutageClosures(trajectory, &out);
-    MoveSwitchInnovations(sideways, &out);
-    return out;
-  }
   const std::vector<TrajectorySample>& samples = trajectory.samples();
+  const int n = static_cast<int>(poses.size());
   // Steps per second (velocity, angular rate in the body frame).
   std::vector<Eigen::Vector3d> velocity(n, Eigen::Vector3d::Zero());
   std::vector<Eigen::Vector3d> rate(n, Eigen::Vector3d::Zero());
@@ -186,42 +174,73 @@ DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
     }
     return m;
   };
-  // Departure of each step from its neighbours' motion. A step across a
-  // gap of the trajectory (survey/trajectory.h) is not one: the vehicle's
-  // motion during the gap is unknown, so it is never taken for a jump.
+  // A step across a gap of the trajectory (survey/trajectory.h) is not one:
+  // the vehicle's motion during the gap is unknown, so it is never taken
+  // for a jump.
   std::vector<bool> across_gap(n, false);
   for (const TrajectoryGap& gap : FindTrajectoryGaps(SampleTimes(samples))) {
     across_gap[gap.before + 1] = true;
   }
-  std::vector<Eigen::Vector3d> position_step(n, Eigen::Vector3d::Zero());
-  std::vector<Eigen::Vector3d> rotation_step(n, Eigen::Vector3d::Zero());
+  StepDepartures departures;
+  departures.position.assign(n, Eigen::Vector3d::Zero());
+  departures.rotation.assign(n, Eigen::Vector3d::Zero());
   for (int i = 1; i < n; ++i) {
     if (across_gap[i]) continue;
     const double dt = samples[i].time - samples[i - 1].time;
-    position_step[i] = (velocity[i] - median_of_neighbours(velocity, i)) * dt;
-    rotation_step[i] = (rate[i] - median_of_neighbours(rate, i)) * dt;
+    departures.position[i] =
+        (velocity[i] - median_of_neighbours(velocity, i)) * dt;
+    departures.rotation[i] = (rate[i] - median_of_neighbours(rate, i)) * dt;
   }
-  // A jump stands out of the trajectory's own motion: at 10 Hz the body's
-  // oscillations on its suspension (a tenth of a degree at 1-2 Hz) depart
-  // from the neighbouring steps by more than a 100 Hz trajectory's do, and
-  // are not jumps. The thresholds are raised to kJumpNoiseFactor times the
-  // median departure when that is larger.
+  return departures;
+}
+
+// A jump stands out of the trajectory's own motion: at 10 Hz the body's
+// oscillations on its suspension (a tenth of a degree at 1-2 Hz) depart
+// from the neighbouring steps by more than a 100 Hz trajectory's do, and
+// are not jumps. A threshold (0: disabled) is raised to kJumpNoiseFactor
+// times the median departure of `steps` when that is larger.
+double NoiseRaisedThreshold(double threshold,
+                            const std::vector<Eigen::Vector3d>& steps) {
   constexpr double kJumpNoiseFactor = 8.0;
-  auto median_norm = [&](const std::vector<Eigen::Vector3d>& steps) {
-    std::vector<double> norms;
-    for (int i = 1; i < n; ++i) norms.push_back(steps[i].norm());
-    std::nth_element(norms.begin(), norms.begin() + norms.size() / 2,
-                     norms.end());
-    return norms[norms.size() / 2];
-  };
-  threshold_m =
-      threshold_m > 0.0
-          ? std::max(threshold_m, kJumpNoiseFactor * median_norm(position_step))
-          : 0.0;
-  threshold_rad = threshold_rad > 0.0
-                      ? std::max(threshold_rad,
-                                 kJumpNoiseFactor * median_norm(rotation_step))
-                      : 0.0;
+  if (!(threshold > 0.0)) return 0.0;
+  std::vector<double> norms;
+  for (size_t i = 1; i < steps.size(); ++i) norms.push_back(steps[i].norm());
+  std::nth_element(norms.begin(), norms.begin() + norms.size() / 2,
+                   norms.end());
+  return std::max(threshold, kJumpNoiseFactor * norms[norms.size() / 2]);
+}
+
+}  // namespace
+
+DejumpedTrajectory RemoveJumps(const Trajectory& trajectory, double threshold_m,
+                               double threshold_rad,
+                               const SidewaysSwitchOptions& switches) {
+  const std::vector<Pose>& poses = trajectory.poses();
+  const int n = static_cast<int>(poses.size());
+  DejumpedTrajectory out;
+  out.poses = poses;
+  out.position_offset.assign(n, Eigen::Vector3d::Zero());
+  out.rotation_offset.assign(n, Eigen::Quaterniond::Identity());
+  std::vector<Eigen::Vector3d> sideways;
+  if (n < 8 || (threshold_m <= 0.0 && threshold_rad <= 0.0)) {
+    out.switches = FindSidewaysSwitches(trajectory, switches, {}, &sideways);
+    Eigen::Vector3d position_jump = Eigen::Vector3d::Zero();
+    out.switch_step.assign(n, false);
+    for (int i = 1; i < n; ++i) {
+      out.switch_step[i] = !sideways[i].isZero();
+      position_jump += sideways[i];
+      out.position_offset[i] = position_jump;
+      out.poses[i].p_enu = poses[i].p_enu - position_jump;
+    }
+    SpreadOutageClosures(trajectory, &out);
+    MoveSwitchInnovations(sideways, &out);
+    return out;
+  }
+  const StepDepartures departures = DepartureOfEachStep(trajectory);
+  const std::vector<Eigen::Vector3d>& position_step = departures.position;
+  const std::vector<Eigen::Vector3d>& rotation_step = departures.rotation;
+  threshold_m = NoiseRaisedThreshold(threshold_m, position_step);
+  threshold_rad = NoiseRaisedThreshold(threshold_rad, rotation_step);
   std::vector<bool> position_jumps(n, false);
   for (int i = 1; i < n; ++i) {
     position_jumps[i] =

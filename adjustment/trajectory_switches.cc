@@ -5,14 +5,11 @@
 #include <deque>
 #include <limits>
 
+#include "survey/math_util.h"
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
-
-double Median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2,
-                   values.end());
-  return values[values.size() / 2];
-}
 
 // The mean of `track` over the samples within +-half_window_s of each.
 std::vector<double> SmoothedTrack(const std::vector<double>& track,
@@ -162,22 +159,13 @@ std::vector<bool> Dilated(const std::vector<bool>& flags,
 }  // namespace
 
 std::string SidewaysSwitchOptions::Check() const {
-  if (!(min_switch_m >= 0.0) || !std::isfinite(min_switch_m)) {
-    return "min_switch_m = " + std::to_string(min_switch_m) +
-           ": must be finite and >= 0 (0 disables)";
-  }
-  if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
-    return "max_duration_s = " + std::to_string(max_duration_s) +
-           ": must be finite and > 0";
-  }
-  if (!(trend_s > 0.0) || !std::isfinite(trend_s)) {
-    return "trend_s = " + std::to_string(trend_s) + ": must be finite and > 0";
-  }
-  if (!(smoothing_s >= 0.0) || !(smoothing_s < max_duration_s)) {
-    return "smoothing_s = " + std::to_string(smoothing_s) +
-           ": must be in [0, max_duration_s)";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GE(check, min_switch_m, 0.0);  // 0 disables
+  OPTION_GT(check, max_duration_s, 0.0);
+  OPTION_GT(check, trend_s, 0.0);
+  OPTION_GE(check, smoothing_s, 0.0);
+  OPTION_LT(check, smoothing_s, max_duration_s);
+  return check.problem();
 }
 
 std::vector<SidewaysSwitch> FindSidewaysSwitches(

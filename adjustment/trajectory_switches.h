@@ -38,6 +38,13 @@ struct SidewaysSwitchOptions {
   double trend_s = 2.0;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("min_switch_m", min_switch_m);
+    v("max_duration_s", max_duration_s);
+    v("smoothing_s", smoothing_s);
+    v("trend_s", trend_s);
+  }
 };
 
 // A switch: the positions moved sideways over the steps into samples

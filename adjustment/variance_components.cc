@@ -43,7 +43,7 @@ bool UpdateAttitudeComponents(const AdjustmentOptions& options,
                               AdjustmentProblem* problem, State* state) {
   auto& knots = state->correction.knots();
   const int n = static_cast<int>(knots.size());
-  if (n < 2 || n > options.max_knots_for_covariance) return false;
+  if (n < 2 || n > options.covariance.max_knots_for_covariance) return false;
   ceres::Covariance::Options covariance_options;
   covariance_options.num_threads = options.solver.num_threads;
   covariance_options.algorithm_type = ceres::SPARSE_QR;
@@ -96,8 +96,8 @@ bool UpdateAttitudeComponents(const AdjustmentOptions& options,
     VLOG(1) << "variance components: attitude axis " << axis << " omega "
             << omega << " redundancy " << redundancy << " ratio " << ratio;
     if (ratio > std::min(c * c * c, kInflateAbove)) {
-      const double widened =
-          std::min(options.max_attitude_sigma_rad, sigma * std::sqrt(ratio));
+      const double widened = std::min(options.model.max_attitude_sigma_rad,
+                                      sigma * std::sqrt(ratio));
       if (widened > 1.05 * sigma) {
         model.attitude_sigma_rad[axis] = widened;
         changed = true;

@@ -60,8 +60,8 @@
 #include <string>
 #include <vector>
 
-#include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
+#include "pipeline/adjustment_pass.h"
 #include "tests/support/synthetic_survey.h"
 #include "tiepoints/tie_points.h"
 
@@ -177,8 +177,8 @@ int ScoreSurvey(const std::string& survey_folder,
   // The GNSS/INS error model as configured (1 m, 30 s), against the one
   // estimated from the control and the trajectory.
   AdjustmentOptions fixed;
-  fixed.estimate_position_model = false;
-  fixed.estimate_variance_components = false;
+  fixed.model.estimate_position_model = false;
+  fixed.model.estimate_variance_components = false;
   const std::vector<Model> models = {{"fixed model", fixed},
                                      {"current", AdjustmentOptions()}};
   std::printf("%s: %zu tie tracks\n", survey_folder.c_str(), tracks.size());
@@ -323,7 +323,7 @@ int Main(int argc, char** argv) {
     const AdjustmentInput input = SyntheticAdjustmentInput(survey, trajectory);
     AdjustmentOptions options;
     options.solver.num_threads = threads;
-    options.compute_covariance = false;
+    options.covariance.compute_covariance = false;
     const auto start = std::chrono::steady_clock::now();
     const AdjustmentResult result = AdjustTrajectory(options, input);
     const double seconds =

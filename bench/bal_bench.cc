@@ -8,8 +8,9 @@
 // ../shared/datasets/bal. COLMAP first drops the observations of points
 // behind a camera and the points seen by fewer than three images; both
 // solvers get that same reduced problem (ReduceLikeColmap), exported exactly
-// to a COLMAP text model (WriteColmapModel). COLMAP's final cost is
-// recomputed here from the model it writes, with the same cost function.
+// to a COLMAP text model (ColmapModelOf, geodata/colmap_export.h). COLMAP's
+// final cost is recomputed here from the model it writes, with the same cost
+// function.
 //
 // COLMAP is optional: install it with `apt-get install colmap` (Debian 12:
 // COLMAP 3.8). Without it the COLMAP column is skipped with a message.
@@ -33,6 +34,7 @@
 
 #include "adjustment/bal/bal_adjuster.h"
 #include "adjustment/bal/bal_problem.h"
+#include "geodata/colmap_export.h"
 
 namespace zebrageo {
 namespace {
@@ -75,7 +77,7 @@ ColmapRun RunColmap(const BalProblem& problem, int threads,
     fs::remove_all(f);
     fs::create_directories(f);
   }
-  WriteColmapModel(problem, input);
+  WriteColmapModel(ColmapModelOf(problem), input);
   std::string cpus = "0";
   for (int i = 1; i < threads; ++i) cpus += "," + std::to_string(i);
   const std::string pin =
@@ -112,7 +114,7 @@ ColmapRun RunColmap(const BalProblem& problem, int threads,
   if (std::regex_search(report, m, std::regex(R"(Residuals\s*:\s*([0-9]+))"))) {
     run.residuals = std::stol(m[1]);
   }
-  const BalProblem adjusted = ReadColmapModel(text);
+  const BalProblem adjusted = BalProblemOf(ReadColmapModel(text));
   run.final_cost = BalCost(adjusted);
   run.ok = true;
   return run;

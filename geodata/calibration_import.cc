@@ -10,6 +10,7 @@
 #include "geodata/text_input.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 #include "survey/yaml_document.h"
 
 namespace zebrageo {
@@ -252,11 +253,9 @@ RosCamera ReadRosCamera(const std::string& path, const std::string& name,
 }  // namespace
 
 std::string CalibrationImportOptions::Check() const {
-  if (!(max_fit_error_px > 0.0)) {
-    return "max_fit_error_px = " + std::to_string(max_fit_error_px) +
-           ": must be > 0";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GT(check, max_fit_error_px, 0.0);
+  return check.problem();
 }
 
 EquidistantFit FitRadtanToEquidistant(double fx, double fy, double cx,

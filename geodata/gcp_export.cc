@@ -65,14 +65,6 @@ const ExposureImage* ImageOf(const Survey& survey, int64_t exposure_id,
   return nullptr;
 }
 
-std::string Fixed(double value, int decimals) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(decimals);
-  out << value;
-  return out.str();
-}
-
 // Decimals for x, y of a CRS: degrees need 9 (0.1 mm), metres or feet 4.
 int HorizontalDecimals(const Eigen::Vector3d& xyz) {
   return std::abs(xyz.x()) <= 360.0 && std::abs(xyz.y()) <= 90.0 ? 9 : 4;
@@ -259,10 +251,11 @@ void WriteOdmGcpList(const std::vector<GroundControlPoint>& gcps,
       const Eigen::Vector3d xyz = crs.from_wgs84(gcp.position);
       const int decimals = HorizontalDecimals(xyz);
       for (const GcpObservation& o : gcp.observations) {
-        out << Fixed(xyz.x(), decimals) << "\t" << Fixed(xyz.y(), decimals)
-            << "\t" << Fixed(xyz.z(), 4) << "\t" << Fixed(o.uv.x(), 3) << "\t"
-            << Fixed(o.uv.y(), 3) << "\t" << o.image_name << "\t" << gcp.name
-            << "\n";
+        out << FormatFixed(xyz.x(), decimals) << "\t"
+            << FormatFixed(xyz.y(), decimals) << "\t" << FormatFixed(xyz.z(), 4)
+            << "\t" << FormatFixed(o.uv.x(), 3) << "\t"
+            << FormatFixed(o.uv.y(), 3) << "\t" << o.image_name << "\t"
+            << gcp.name << "\n";
       }
     }
   });
@@ -309,11 +302,11 @@ void WriteMetashapeMarkers(const std::vector<GroundControlPoint>& gcps,
   for (const GroundControlPoint& gcp : gcps) {
     const Eigen::Vector3d xyz = crs.from_wgs84(gcp.position);
     const int decimals = HorizontalDecimals(xyz);
-    out << gcp.name << "," << Fixed(xyz.x(), decimals) << ","
-        << Fixed(xyz.y(), decimals) << "," << Fixed(xyz.z(), 4) << ","
-        << FormatDouble(gcp.sigma_xy_m) << "," << FormatDouble(gcp.sigma_xy_m)
-        << "," << FormatDouble(gcp.sigma_z_m) << ","
-        << (gcp.role == GcpRole::kControl ? 1 : 0) << "\n";
+    out << gcp.name << "," << FormatFixed(xyz.x(), decimals) << ","
+        << FormatFixed(xyz.y(), decimals) << "," << FormatFixed(xyz.z(), 4)
+        << "," << FormatDouble(gcp.sigma_xy_m) << ","
+        << FormatDouble(gcp.sigma_xy_m) << "," << FormatDouble(gcp.sigma_z_m)
+        << "," << (gcp.role == GcpRole::kControl ? 1 : 0) << "\n";
   }
   AtomicFile projections(projections_path);
   std::ostream& projection_out = projections.stream();
@@ -322,7 +315,8 @@ void WriteMetashapeMarkers(const std::vector<GroundControlPoint>& gcps,
   for (const GroundControlPoint& gcp : gcps) {
     for (const GcpObservation& o : gcp.observations) {
       projection_out << gcp.name << "," << o.image_name << ","
-                     << Fixed(o.uv.x(), 3) << "," << Fixed(o.uv.y(), 3) << "\n";
+                     << FormatFixed(o.uv.x(), 3) << ","
+                     << FormatFixed(o.uv.y(), 3) << "\n";
     }
   }
   projections.Commit();

@@ -1,232 +1,240 @@
-// The adjust stage: the trajectory adjusted with the matched band vertices
-// (and road lines) as control, its files written through the contract.
+#include "pipeline/adjust_stage.h"
+
 #include <glog/logging.h>
 
 #include <algorithm>
-#include <filesystem>
+#include <optional>
 #include <set>
 #include <utility>
 
-#include "adjustment/adjustment_io.h"
-#include "adjustment/trajectory_adjuster.h"
+#include "geodata/colmap_export.h"
+#include "pipeline/adjust_outputs.h"
+#include "pipeline/adjustment_pass.h"
 #include "pipeline/exit_codes.h"
-#include "pipeline/stages.h"
-#include "registration/match_stage.h"
+#include "pipeline/rematch_stage.h"
 #include "survey/atomic_file.h"
 #include "survey/output_crs.h"
 #include "survey/results.h"
+#include "survey/results_adjustment.h"
+#include "survey/results_lines.h"
 #include "tiepoints/tie_points.h"
 
 namespace zebrageo {
 namespace {
 
+constexpr int kMaxRematchPasses = 3;
+
+// The tie tracks of the survey's images, once for every adjustment.
+struct TiePoints {
+  bool used = false;
+  std::vector<TieTrack> tracks;
+  TiePointSummary summary;
+};
+
+// Step "tie points": with RunOptions::tie_points and images on disk.
+TiePoints MatchTiePoints(const AdjustmentData& data, const RunOptions& options,
+                         const ProgressListener& progress,
+                         const CancellationToken& cancel) {
+  TiePoints ties;
+  ties.used =
+      options.tie_points &&
+      data.missing_images < static_cast<int>(data.exposures.images.size());
+  if (!ties.used) return ties;
+  StepProgress step(progress, "tie points");
+  ties.tracks = BuildTieTracks(options.tie_point_matching, data.survey_folder,
+                               data.rig, data.trajectory, data.exposures,
+                               &ties.summary, step.Callback(), cancel);
+  step.Finish();
+  return ties;
+}
+
+// What the stage carries from step to step and writes at its end.
+struct AdjustState {
+  // The control: the match stage's, less what the adjustment rejected,
+  // with what the second pass added.
+  std::vector<VertexMatch> matches;
+  std::vector<CrossingDecision> decisions;
+  // The comments of matches.csv and crossing_decisions.csv once a step
+  // changed them (else the match stage's files stand).
+  std::optional<std::vector<std::string>> matches_comments;
+  std::optional<std::vector<std::string>> decisions_comments;
+  // The last adjustment: its data (the control it was given), result and
+  // record, and the last registration of the road lines.
+  AdjustmentData data;
+  AdjustmentPass pass;
+  AdjustmentRecord record;
+  std::optional<LineRegistration> lines;
+  std::vector<std::string> warnings;
+};
+
 // Exposures the reconstruction skipped (their images could not be read):
 // they get no pose (SURVEY_FORMAT.md).
-std::set<int64_t> SkippedExposureIds(StageResults* results) {
-  std::set<int64_t> ids;
+void DropSkippedExposures(StageResults* results, AdjustmentResult* result) {
+  std::set<int64_t> skipped;
   for (const SkippedExposure& s : results->SkippedExposures()) {
-    ids.insert(s.exposure_id);
+    skipped.insert(s.exposure_id);
   }
-  return ids;
+  auto& poses = result->camera_poses;
+  poses.erase(std::remove_if(poses.begin(), poses.end(),
+                             [&skipped](const CameraPose& pose) {
+                               return skipped.count(pose.exposure_id) > 0;
+                             }),
+              poses.end());
 }
 
-// The times of the line control points that hold the position across
-// their line (not the height alone, not a dash's along-track position),
-// sorted.
-std::vector<double> CrossTrackTimes(
-    const std::vector<LineControlPoint>& control) {
-  std::vector<double> times;
-  for (const LineControlPoint& c : control) {
-    if (!c.along_track && c.sqrt_information.row(0).norm() > 0.0) {
-      times.push_back(c.time);
-    }
+// "adjust needs a usable result": the solver's message names no input, so
+// the survey's warnings (gaps, rates, with their lines and times) follow.
+[[noreturn]] void FailUnusable(const Survey& survey,
+                               const AdjustmentSummary& summary) {
+  std::string context;
+  for (size_t i = 0; i < survey.warnings.size() && i < 3; ++i) {
+    context +=
+        (i == 0 ? "; the survey's warnings: " : "; ") + survey.warnings[i];
   }
-  std::sort(times.begin(), times.end());
-  times.erase(std::unique(times.begin(), times.end()), times.end());
-  return times;
+  throw StageFailedError("adjust: " + summary.message +
+                         "; no results were written" + context);
 }
 
-// The times of the control points of CrossTrackTimes that `result`'s
-// trajectory fits across their line within max_residual_m, sorted. A
-// point it does not fit (a GNSS switch the smooth correction could not
-// follow, a line moved in the database) measured nothing the trajectory
-// holds.
-std::vector<double> FittedCrossTrackTimes(
-    const std::vector<LineControlPoint>& control,
-    const AdjustmentResult& result, double max_residual_m) {
-  const auto& samples = result.corrected_samples;
-  if (samples.size() < 2 || result.corrected_poses.size() != samples.size()) {
-    return {};
-  }
-  std::vector<LineControlPoint> fitted;
-  for (const LineControlPoint& c : control) {
-    if (c.time < samples.front().time || c.time > samples.back().time) {
-      continue;
-    }
-    // Interpolated as Trajectory::InterpolatePose does.
-    const auto it = std::upper_bound(
-        samples.begin(), samples.end(), c.time,
-        [](double t, const TrajectorySample& s) { return t < s.time; });
-    const size_t i = std::min<size_t>(
-        std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
-    const double span = samples[i + 1].time - samples[i].time;
-    const double u = span > 0.0 ? (c.time - samples[i].time) / span : 0.0;
-    const Pose pose = InterpolatePoses(result.corrected_poses[i],
-                                       result.corrected_poses[i + 1], u);
-    const double residual =
-        c.across_enu.dot(pose.T_enu_body() * c.p_body - c.db_point_enu);
-    if (std::abs(residual) <= max_residual_m) fitted.push_back(c);
-  }
-  return CrossTrackTimes(fitted);
-}
-
-}  // namespace
-
-AdjustmentResult AdjustWithRoadLines(
-    const AdjustmentData& data, AdjustmentInput input,
-    const AdjustmentOptions& options,
-    const std::vector<ReconstructedLinePoint>* line_points,
-    const std::string& results_folder, std::vector<std::string>* warnings,
-    const ProgressListener& progress, std::vector<double>* line_control_times,
-    std::vector<double>* fitted_line_times) {
-  if (line_control_times != nullptr) line_control_times->clear();
-  if (fitted_line_times != nullptr) fitted_line_times->clear();
-  StepProgress step(progress, "adjust");
-  AdjustmentResult result = AdjustTrajectory(options, input, step.Callback());
-  step.Finish();
-  if (line_points == nullptr || !result.summary.IsUsable()) return result;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data, options, result, line_points, results_folder, warnings);
-  if (control.empty()) return result;
-  if (line_control_times != nullptr) {
-    *line_control_times = CrossTrackTimes(control);
-  }
-  input.line_points = &control;
-  StepProgress line_step(progress, "adjust with lines");
-  result = AdjustTrajectory(options, input, line_step.Callback());
-  line_step.Finish();
-  if (fitted_line_times != nullptr && result.summary.IsUsable()) {
-    *fitted_line_times =
-        FittedCrossTrackTimes(control, result, kFittedLineResidualM);
-  }
-  return result;
-}
-
-bool SecondPassOnRoadLines(const AdjustmentRecord& record,
-                           const std::vector<CrossingDecision>& decisions,
-                           bool lines) {
-  if (!lines || record.road_lines_only) return false;
-  const int crossings =
-      record.counts.control_crossings + record.counts.check_crossings;
-  if (crossings >= RematchOptions().min_control_crossings) return false;
-  for (const CrossingDecision& d : decisions) {
-    if (d.decision != Decision::kMatched) return true;
-  }
-  return false;
-}
-
-std::vector<std::string> RunAdjustStage(
-    const Survey& survey, StageResults* results,
-    const AdjustmentOptions& options, bool tie_points, bool lines,
-    const ProgressListener& progress, std::vector<double>* line_control_times,
-    std::vector<double>* fitted_line_times) {
-  const std::string& results_folder = results->folder();
-  // The survey as loaded (not read again), with the stages' outputs.
+// Step "adjust" on the control so far, then "keep control".
+void Adjust(const Survey& survey, StageResults* results, const TiePoints& ties,
+            const RunOptions& options, const ProgressListener& progress,
+            const CancellationToken& cancel, AdjustState* state) {
   AdjustmentData data =
-      AdjustmentDataOf(survey, results->Vertices(), results->Matches());
-  // The survey's warnings first: adjustment.json and the adjust command's
-  // report.json list them too.
+      AdjustmentDataOf(survey, results->Vertices(), state->matches);
+  // The survey's warnings first: adjustment.json and the report list them.
   data.warnings.insert(data.warnings.begin(), survey.warnings.begin(),
                        survey.warnings.end());
   LOG(INFO) << "adjust: " << data.vertices.size() << " reconstructed vertices, "
             << data.matches.size() << " matches, "
             << data.exposures.exposures.size() << " exposures";
-
-  std::vector<TieTrack> tracks;
-  TiePointSummary tie_summary;
-  const bool use_ties =
-      tie_points &&
-      data.missing_images < static_cast<int>(data.exposures.images.size());
-  if (use_ties) {
-    StepProgress step(progress, "tie points");
-    tracks = BuildTieTracks(TiePointOptions(), data.survey_folder, data.rig,
-                            data.trajectory, data.exposures, &tie_summary,
-                            step.Callback());
-    step.Finish();
-  }
   AdjustmentInput input = data.Input();
-  if (use_ties) input.tie_tracks = &tracks;
-
-  std::vector<std::string> warnings = data.warnings;
-  AdjustmentResult result = AdjustWithRoadLines(
-      data, input, options, lines ? results->LinePoints() : nullptr,
-      results_folder, &warnings, progress, line_control_times,
-      fitted_line_times);
-  if (!result.summary.IsUsable()) {
-    // A solver's message ("Ceres failed: ...") names no input: the survey's
-    // warnings (gaps, rates, with their lines and times) may.
-    std::string context;
-    for (size_t i = 0; i < survey.warnings.size() && i < 3; ++i) {
-      context +=
-          (i == 0 ? "; the survey's warnings: " : "; ") + survey.warnings[i];
-    }
-    throw StageFailedError("adjust: " + result.summary.message +
-                           "; no results were written" + context);
+  if (ties.used) input.tie_tracks = &ties.tracks;
+  AdjustmentPass pass = AdjustWithRoadLines(
+      data, input, options.adjustment, options.line_registration,
+      options.lines ? results->LinePoints() : nullptr, progress, cancel);
+  if (!pass.result.summary.IsUsable())
+    FailUnusable(survey, pass.result.summary);
+  state->warnings = data.warnings;
+  if (pass.lines) {
+    state->warnings.insert(state->warnings.end(), pass.lines->warnings.begin(),
+                           pass.lines->warnings.end());
+    if (pass.lines->record) state->lines = pass.lines;
   }
-  const std::set<int64_t> skipped = SkippedExposureIds(results);
-  result.camera_poses.erase(
-      std::remove_if(result.camera_poses.begin(), result.camera_poses.end(),
-                     [&skipped](const CameraPose& pose) {
-                       return skipped.count(pose.exposure_id) > 0;
-                     }),
-      result.camera_poses.end());
-  RemoveStaleTemporaries(results_folder);
-  AdjustmentRecord record = WriteAdjustmentResults(
-      data, options, result, use_ties ? &tie_summary : nullptr, results_folder);
-  std::vector<VertexMatch> matches = std::move(data.matches);
-  std::vector<CrossingDecision> decisions = results->Decisions();
-  const int removed =
-      RemoveRejectedMatches(result, results_folder, &matches, &decisions);
-  results->SetMatches(std::move(matches), std::move(decisions));
-  results->SetAdjustment(std::move(result.corrected_samples),
-                         std::move(record));
+  DropSkippedExposures(results, &pass.result);
+  state->record = AdjustmentRecordOf(data, options.adjustment, pass.result,
+                                     ties.used ? &ties.summary : nullptr);
+  std::string crossings;
+  const int removed = RemoveRejectedMatches(pass.result, &state->matches,
+                                            &state->decisions, &crossings);
   if (removed > 0) {
+    state->matches_comments = {
+        "zebrageo adjust removed " + std::to_string(removed) +
+        " vertex matches the adjustment rejected (crossings " + crossings +
+        "; gcp_residuals.csv, report.json warnings)"};
+    // Without decisions (results of an older version) there is nothing to
+    // rewrite.
+    if (!state->decisions.empty()) {
+      state->decisions_comments = {"zebrageo match, then adjust"};
+    }
     LOG(INFO) << "adjust: " << removed
               << " vertex matches rejected by the adjustment removed from "
               << kMatchesFile;
   }
-  // survey.yaml's output_crs, beside the contract's WGS84 and ENU columns.
-  AddOutputCrs(survey, results_folder);
-  LOG(INFO) << "adjust: " << result.summary.BriefReport();
-  return warnings;
+  LOG(INFO) << "adjust: " << pass.result.summary.BriefReport();
+  state->data = std::move(data);
+  state->pass = std::move(pass);
 }
 
-std::optional<RoadLinesAdjustment> AdjustByRoadLinesAlone(
-    const AdjustmentData& data,
-    const std::vector<ReconstructedLinePoint>* line_points,
-    const AdjustmentOptions& user_options) {
-  if (line_points == nullptr || line_points->empty() ||
-      !user_options.line_control_without_crossings) {
-    return std::nullopt;
+// Step "rematch": the second registration pass on the last adjustment; true
+// when it changed the control.
+bool Rematch(const Survey& survey, StageResults* results,
+             const RunOptions& options, const CancellationToken& cancel,
+             AdjustState* state, std::vector<std::string>* refusals) {
+  AdjustedTrajectory adjusted;
+  adjusted.record = &state->record;
+  adjusted.trajectory = &state->pass.result.corrected_samples;
+  adjusted.line_control_times = state->pass.line_control_times;
+  adjusted.fitted_line_times = state->pass.fitted_line_times;
+  adjusted.rejected_crossings = RejectedCrossings(state->pass.result);
+  RematchSummary rematch = RematchStep(
+      survey, options, adjusted, results->Vertices(), state->matches,
+      state->decisions, results->LinePoints(), cancel);
+  LOG(INFO) << rematch.message;
+  // Logged as a warning, so listed in report.json too.
+  if (rematch.disagreements > 0) refusals->push_back(rematch.message);
+  if (rematch.added == 0 && rematch.dropped == 0) return false;
+  state->matches = std::move(rematch.matches);
+  state->decisions = std::move(rematch.decisions);
+  state->matches_comments = {"zebrageo run: " + rematch.message};
+  state->decisions_comments = state->matches_comments;
+  return true;
+}
+
+// Step "write": every file of the stage, once.
+void WriteAdjustStage(const Survey& survey, const AdjustState& state,
+                      const std::string& folder) {
+  const std::unique_ptr<OutputCrs> crs = OutputCrs::Of(survey);
+  auto path = [&folder](const char* name) { return folder + "/" + name; };
+  RemoveStaleTemporaries(folder);
+  const AdjustmentResult& result = state.pass.result;
+  WriteColmapModel(ColmapModelOf(state.data, result), path(kColmapFolder));
+  WriteGcpResiduals(GcpResidualsOf(result.control_points),
+                    path(kGcpResidualsFile), crs.get());
+  WriteAdjustedBands(result.bands, path(kBandsGeoJsonFile), crs.get());
+  WriteAdjustmentRecord(state.record, path(kAdjustmentJsonFile));
+  if (state.lines) {
+    WriteLineMatches(state.lines->rows, path(kLineMatchesFile));
+    WriteLineControl(*state.lines->record, path(kLineControlFile));
   }
-  AdjustmentOptions options = user_options;
-  options.log_warnings = false;  // a trial: the user gets another result
-  AdjustmentInput input = data.Input();
-  const std::vector<VertexMatch> no_matches;
-  input.matches = &no_matches;
-  // Without control the first adjustment keeps the input trajectory; the
-  // lines are then placed by the cross-track offsets they agree on.
-  std::vector<std::string> warnings;
-  RoadLinesAdjustment out;
-  AdjustmentResult result =
-      AdjustWithRoadLines(data, input, options, line_points, "", &warnings,
-                          nullptr, &out.line_control_times);
-  if (!result.summary.IsUsable() || !result.summary.line_control_only) {
-    return std::nullopt;
+  if (state.matches_comments) {
+    WriteMatches(state.matches, *state.matches_comments, path(kMatchesFile),
+                 crs.get());
   }
-  out.record = AdjustmentRecordOf(data, options, result, nullptr);
-  out.trajectory = std::move(result.corrected_samples);
-  return out;
+  if (state.decisions_comments) {
+    WriteCrossingDecisions(state.decisions, *state.decisions_comments,
+                           path(kCrossingDecisionsFile));
+  }
+  // The trajectory and the poses last: their presence means the stage
+  // finished.
+  WriteTrajectorySamples(result.corrected_samples,
+                         path(kTrajectoryCorrectedFile), crs.get());
+  WriteCameraPoses(result.camera_poses, path(kPosesFile), crs.get());
+}
+
+}  // namespace
+
+std::vector<std::string> RunAdjustStage(const Survey& survey,
+                                        StageResults* results,
+                                        const RunOptions& options,
+                                        const ProgressListener& progress,
+                                        const CancellationToken& cancel) {
+  // The output CRS is checked before anything runs.
+  OutputCrs::Of(survey);
+  AdjustState state;
+  state.matches = results->Matches();
+  state.decisions = results->Decisions();
+  const TiePoints ties = MatchTiePoints(AdjustmentDataOf(survey, {}, {}),
+                                        options, progress, cancel);
+  // With the second pass, an adjustment before it may not be the result:
+  // its warnings go to the report (and stderr) only if it is.
+  RunOptions trial = options;
+  trial.adjustment.log_warnings = !options.rematch;
+  Adjust(survey, results, ties, trial, progress, cancel, &state);
+  std::vector<std::string> refusals;
+  for (int pass = 0; options.rematch && pass < kMaxRematchPasses; ++pass) {
+    cancel.ThrowIfCancelled();
+    if (!Rematch(survey, results, options, cancel, &state, &refusals)) break;
+    const bool again = pass + 1 < kMaxRematchPasses;
+    Adjust(survey, results, ties, again ? trial : options, progress, cancel,
+           &state);
+  }
+  cancel.ThrowIfCancelled();
+  WriteAdjustStage(survey, state, results->folder());
+  results->SetMatches(state.matches, state.decisions);
+  results->SetAdjustment(state.pass.result.corrected_samples, state.record);
+  std::vector<std::string> warnings = state.warnings;
+  warnings.insert(warnings.end(), refusals.begin(), refusals.end());
+  return warnings;
 }
 
 }  // namespace zebrageo

@@ -20,6 +20,9 @@ enum ExitCode : int {
   kExitNotImplemented = 4,
   // A bug or an environment failure (disk full, out of memory).
   kExitInternalError = 5,
+  // Cancelled (SIGINT, SIGTERM): the stage in progress wrote nothing, a
+  // rerun resumes the stages before it.
+  kExitCancelled = 6,
 };
 
 // Thrown by a command whose stage is not built yet: a clear error, never a

@@ -1,5 +1,5 @@
-// The reconstruct stage: zebra bands (and road lines) of every stereo pair
-// into the results folder.
+#include "pipeline/reconstruct_stage.h"
+
 #include <glog/logging.h>
 
 #include <algorithm>
@@ -10,17 +10,21 @@
 #include <vector>
 
 #include "pipeline/exit_codes.h"
-#include "pipeline/stages.h"
+#include "reconstruction/reconstruction.h"
+#include "reconstruction/road_lines.h"
 #include "survey/input_error.h"
 #include "survey/results.h"
+#include "survey/results_lines.h"
 
 namespace zebrageo {
 
+namespace {
+
+// Images that exist but cannot be decoded are only found here (loading
+// checks existence): the same share as for missing images makes the survey
+// invalid rather than quietly thin.
 void ThrowIfTooManyUnreadable(const Survey& survey,
                               const ReconstructionSummary& summary) {
-  // Images that exist but cannot be decoded are only found here (loading
-  // checks existence); the same share as for missing images makes the survey
-  // invalid rather than quietly thin.
   const int total = static_cast<int>(survey.exposures.exposures.size());
   const double max_fraction = SurveyLoadOptions().max_missing_image_fraction;
   if (summary.exposures_skipped == 0 ||
@@ -42,17 +46,18 @@ void ThrowIfTooManyUnreadable(const Survey& survey,
   throw InputError(survey.manifest.exposures, 0, problem.str());
 }
 
-std::vector<std::string> RunReconstructStage(
+// The zebra bands; *road_plane: the road plane in the body frame as the
+// stage estimated it.
+std::vector<std::string> ReconstructBands(
     const Survey& survey, const ReconstructionOptions& options,
     StageResults* results, const std::function<void(int, int)>& progress,
-    RoadPlane* road_plane) {
-  std::filesystem::create_directories(results->folder());
+    const CancellationToken& cancel, RoadPlane* road_plane) {
   std::vector<ReconstructedVertex> vertices;
   const ReconstructionSummary summary =
-      ReconstructSurvey(survey, options, &vertices, progress);
+      ReconstructSurvey(survey, options, &vertices, progress, cancel);
   ThrowIfTooManyUnreadable(survey, summary);
   if (!summary.IsUsable()) throw StageFailedError(summary.message);
-  if (road_plane != nullptr) *road_plane = summary.final_road_plane;
+  *road_plane = summary.final_road_plane;
 
   StepTimings mean = summary.timings;
   const double n = std::max(1, summary.pairs_processed);
@@ -84,16 +89,15 @@ std::vector<std::string> RunReconstructStage(
   return summary.warnings;
 }
 
-std::vector<std::string> RunRoadLinesStage(
+// The road lines on `road_plane`.
+std::vector<std::string> ReconstructRoadLines(
     const Survey& survey, const RoadPlane& road_plane,
     const RoadLineOptions& options, int threads, StageResults* results,
-    const std::function<void(int, int)>& progress) {
-  const std::string error = options.Check();
-  if (!error.empty()) throw StageFailedError(error);
-  std::filesystem::create_directories(results->folder());
+    const std::function<void(int, int)>& progress,
+    const CancellationToken& cancel) {
   std::vector<ReconstructedLinePoint> points;
   const RoadLineSummary summary = ExtractSurveyLines(
-      survey, road_plane, options, threads, &points, progress);
+      survey, road_plane, options, threads, &points, progress, cancel);
   std::vector<std::string> warnings;
   if (summary.lines == 0) warnings.push_back("no road line was reconstructed");
   WriteReconstructedLines(
@@ -101,6 +105,28 @@ std::vector<std::string> RunRoadLinesStage(
       results->PathOf(kReconstructedLinesFile));
   results->SetLinePoints(std::move(points));
   LOG(INFO) << "road lines: " << summary.BriefReport();
+  return warnings;
+}
+
+}  // namespace
+
+std::vector<std::string> RunReconstructStage(
+    const Survey& survey, StageResults* results, const RunOptions& options,
+    const std::function<void(int, int)>& progress,
+    const ProgressListener& steps, const CancellationToken& cancel) {
+  std::filesystem::create_directories(results->folder());
+  RoadPlane road_plane;
+  std::vector<std::string> warnings = ReconstructBands(
+      survey, options.reconstruction, results, progress, cancel, &road_plane);
+  if (!options.lines) return warnings;
+  cancel.ThrowIfCancelled();
+  StepProgress step(steps, "road lines");
+  for (const std::string& w : ReconstructRoadLines(
+           survey, road_plane, options.road_lines, options.threads, results,
+           step.Callback(), cancel)) {
+    warnings.push_back(w);
+  }
+  step.Finish();
   return warnings;
 }
 

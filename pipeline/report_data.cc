@@ -6,6 +6,7 @@
 
 #include "survey/input_error.h"
 #include "survey/json_file.h"
+#include "survey/math_util.h"
 #include "survey/results_adjustment.h"
 #include "survey/results_lines.h"
 
@@ -50,10 +51,9 @@ ReportData Collect(const ReportInputs& inputs) {
           survey.frame.EnuFromGeodetic(corrected[i].position);
       data.correction_enu.push_back(p - data.input_enu[i]);
       data.heading_correction_deg.push_back(
-          std::remainder(corrected[i].attitude.heading -
-                             trajectory.samples()[i].attitude.heading,
-                         2.0 * M_PI) *
-          kRadToDeg);
+          RadToDeg(std::remainder(corrected[i].attitude.heading -
+                                      trajectory.samples()[i].attitude.heading,
+                                  2.0 * kPi)));
     }
   } else {
     data.missing_files.push_back(kTrajectoryCorrectedFile);

@@ -1,6 +1,6 @@
 // What the report shows, gathered once from a results folder and the survey
-// (pipeline/report.h); shared by the report's JSON (report.cc) and its HTML
-// page (report_html.cc). Internal to the pipeline library.
+// (pipeline/report_stage.h); shared by the report's JSON (report_stage.cc) and
+// its HTML page (report_html.cc). Internal to the pipeline library.
 #ifndef ZEBRAGEO_PIPELINE_REPORT_DATA_H_
 #define ZEBRAGEO_PIPELINE_REPORT_DATA_H_
 
@@ -10,13 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 #include "survey/results.h"
 
 namespace zebrageo {
 namespace report_internal {
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // Everything the report shows, gathered once from the results folder.
 struct ReportData {

@@ -4,7 +4,8 @@
 
 #include "pipeline/report_data.h"
 #include "pipeline/svg_plot.h"
-#include "tools/version.h"
+#include "pipeline/version.h"
+#include "survey/csv.h"
 
 namespace zebrageo {
 namespace report_internal {
@@ -14,15 +15,8 @@ using nlohmann::json;
 
 // --- HTML ---------------------------------------------------------------
 
-std::string Fixed(double value, int decimals) {
-  std::ostringstream text;
-  text.precision(decimals);
-  text << std::fixed << value;
-  return text.str();
-}
-
 std::string JsonCell(const json& value) {
-  if (value.is_number_float()) return Fixed(value.get<double>(), 3);
+  if (value.is_number_float()) return FormatFixed(value.get<double>(), 3);
   if (value.is_string()) return EscapeHtml(value.get<std::string>());
   if (value.is_null()) return "";
   return EscapeHtml(value.dump());
@@ -173,7 +167,7 @@ std::string ResidualPlots(const ReportData& data) {
   SvgPlot vectors("Horizontal GCP residuals (adjusted minus database)",
                   "east (m)", "north (m)", 860, 520);
   vectors.SetEqualAspect(true);
-  vectors.SetNote("arrows exaggerated x" + Fixed(scale, 0) +
+  vectors.SetNote("arrows exaggerated x" + FormatFixed(scale, 0) +
                   "; blue = control, red = check");
   for (size_t i = 0; i < data.residuals.size(); ++i) {
     const Eigen::Vector3d& p = data.residual_positions_enu[i];
@@ -284,9 +278,10 @@ std::string BeforeAfterFigure(const json& adjustment) {
       const int bar_y = y + row++ * 18;
       const double w = std::max(1.0, kBarPx * value / top);
       rows << "<rect x='" << kLabelPx << "' y='" << bar_y << "' width='"
-           << Fixed(w, 1) << "' height='14' fill='" << colour << "'/><text x='"
-           << kLabelPx + w + 6 << "' y='" << bar_y + 11 << "'>" << name << " "
-           << Fixed(value, 3) << " " << EscapeHtml(unit) << "</text>";
+           << FormatFixed(w, 1) << "' height='14' fill='" << colour
+           << "'/><text x='" << kLabelPx + w + 6 << "' y='" << bar_y + 11
+           << "'>" << name << " " << FormatFixed(value, 3) << " "
+           << EscapeHtml(unit) << "</text>";
     }
     rows << "\n";
     ++n;
@@ -323,8 +318,9 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   html << "<p>zebrageo " << ZEBRAGEO_VERSION_STRING << ". Survey "
        << EscapeHtml(report["survey"]["folder"].get<std::string>()) << ": "
        << report["survey"]["exposures"] << " exposures, "
-       << Fixed(report["survey"]["length_m"].get<double>(), 0) << " m, "
-       << Fixed(report["survey"]["duration_s"].get<double>(), 1) << " s.</p>\n";
+       << FormatFixed(report["survey"]["length_m"].get<double>(), 0) << " m, "
+       << FormatFixed(report["survey"]["duration_s"].get<double>(), 1)
+       << " s.</p>\n";
 
   html << "<h2>Warnings</h2>\n";
   if (report["warnings"].empty()) html << "<p class='none'>none</p>\n";
@@ -392,7 +388,8 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   html << "<h2>Stage timings</h2>\n" << KeyValueTable(report["timings_s"]);
   if (report.contains("peak_memory_mb")) {
     html << "<p>Peak memory: "
-         << Fixed(report["peak_memory_mb"].get<double>(), 0) << " MB.</p>\n";
+         << FormatFixed(report["peak_memory_mb"].get<double>(), 0)
+         << " MB.</p>\n";
   }
   if (report.contains("adjustment")) {
     html << "<h2>Adjustment</h2>\n" << KeyValueTable(report["adjustment"]);

@@ -2,7 +2,6 @@
 
 #include <glog/logging.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -11,13 +10,17 @@
 
 #include "pipeline/exit_codes.h"
 #include "pipeline/progress.h"
+#include "pipeline/version.h"
 #include "survey/atomic_file.h"
-#include "tools/version.h"
 
 namespace zebrageo {
 namespace {
 
 using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr uint64_t kFnvOffset = 14695981039346656037ull;
+constexpr uint64_t kFnvPrime = 1099511628211ull;
 
 json ReadState(const std::string& path) {
   std::ifstream in(path);
@@ -38,7 +41,7 @@ void WriteState(const std::string& path, const json& state) {
 
 bool OutputsPresent(const std::string& folder, const PipelineStage& stage) {
   for (const std::string& output : stage.outputs) {
-    if (!std::filesystem::is_regular_file(folder + "/" + output)) return false;
+    if (!fs::is_regular_file(folder + "/" + output)) return false;
   }
   return true;
 }
@@ -47,74 +50,131 @@ bool OutputsPresent(const std::string& folder, const PipelineStage& stage) {
 // build keeps its version number) must not resume outputs of the old one.
 std::string ExecutableStamp() {
   std::error_code error;
-  const std::filesystem::path self =
-      std::filesystem::read_symlink("/proc/self/exe", error);
+  const fs::path self = fs::read_symlink("/proc/self/exe", error);
   if (error) return "";
-  const auto size = std::filesystem::file_size(self, error);
+  const auto size = fs::file_size(self, error);
   if (error) return "";
-  const auto time = std::filesystem::last_write_time(self, error);
+  const auto time = fs::last_write_time(self, error);
   if (error) return "";
   std::ostringstream stamp;
   stamp << size << ":" << time.time_since_epoch().count();
   return stamp.str();
 }
 
+int StageIndex(const std::vector<PipelineStage>& stages,
+               const std::string& name) {
+  for (size_t i = 0; i < stages.size(); ++i) {
+    if (stages[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// The index of the first stage to run: the named from_stage, the first
+// that cannot be resumed (not recorded complete with its fingerprint, an
+// output missing), or an earlier one whose outputs a stage that must run
+// rewrote; stages.size() when everything resumes.
+size_t FirstStageToRun(const std::string& folder,
+                       const std::vector<PipelineStage>& stages,
+                       const json& records, int from_index) {
+  size_t first =
+      from_index >= 0 ? static_cast<size_t>(from_index) : stages.size();
+  for (size_t i = 0; i < first; ++i) {
+    const json& record = records.value(stages[i].name, json::object());
+    if (!record.value("complete", false) ||
+        record.value("fingerprint", "") != stages[i].fingerprint ||
+        !OutputsPresent(folder, stages[i])) {
+      first = i;
+    }
+  }
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (size_t i = first; i < stages.size(); ++i) {
+      for (const std::string& name : stages[i].rewrites) {
+        const int j = StageIndex(stages, name);
+        if (j >= 0 && static_cast<size_t>(j) < first &&
+            records.value(name, json::object()).value("rewritten", false)) {
+          first = static_cast<size_t>(j);
+          moved = true;
+        }
+      }
+    }
+  }
+  return first;
+}
+
 }  // namespace
 
-std::string InputFingerprint(const std::vector<std::string>& input_files,
-                             const std::string& settings) {
-  std::ostringstream text;
-  text << ZEBRAGEO_VERSION_STRING << "|" << ExecutableStamp() << "|"
-       << settings;
-  for (const std::string& file : input_files) {
-    std::error_code error;
-    const auto size = std::filesystem::file_size(file, error);
-    const auto time = std::filesystem::last_write_time(file, error);
-    text << "|" << file << ":" << (error ? 0 : size) << ":"
-         << time.time_since_epoch().count();
+StageFingerprint::StageFingerprint() : hash_(kFnvOffset) {
+  Add(ZEBRAGEO_VERSION_STRING).Add(ExecutableStamp());
+}
+
+void StageFingerprint::Mix(const char* data, size_t size) {
+  for (size_t i = 0; i < size; ++i) {
+    hash_ = (hash_ ^ static_cast<unsigned char>(data[i])) * kFnvPrime;
   }
+}
+
+StageFingerprint& StageFingerprint::Add(const std::string& text) {
+  // The length first: "ab" + "c" and "a" + "bc" differ.
+  const std::string length = std::to_string(text.size()) + ":";
+  Mix(length.data(), length.size());
+  Mix(text.data(), text.size());
+  return *this;
+}
+
+StageFingerprint& StageFingerprint::AddFileContents(const std::string& path) {
+  Add(path);
+  std::ifstream in(path, std::ios::binary);
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
+    Mix(buffer, static_cast<size_t>(in.gcount()));
+  }
+  return *this;
+}
+
+StageFingerprint& StageFingerprint::AddFileStamp(const std::string& path) {
+  std::error_code error;
+  const auto size = fs::file_size(path, error);
+  const auto time = fs::last_write_time(path, error);
+  return Add(path + ":" + std::to_string(error ? 0 : size) + ":" +
+             std::to_string(time.time_since_epoch().count()));
+}
+
+std::string StageFingerprint::Hex() const {
   std::ostringstream hex;
-  hex << std::hex << std::hash<std::string>()(text.str());
+  hex << std::hex << hash_;
   return hex.str();
 }
 
 PipelineRun RunPipeline(const std::string& results_folder,
-                        const std::string& fingerprint,
                         const std::vector<PipelineStage>& stages,
                         const PipelineOptions& options,
-                        const ProgressListener& progress) {
-  int from_index = -1;
-  if (!options.from_stage.empty()) {
-    for (size_t i = 0; i < stages.size(); ++i) {
-      if (stages[i].name == options.from_stage)
-        from_index = static_cast<int>(i);
-    }
-    if (from_index < 0) {
-      std::string names;
-      for (const PipelineStage& stage : stages) names += " " + stage.name;
-      throw UsageError("--from " + options.from_stage +
-                       ": not a stage (stages:" + names + ")");
-    }
+                        const ProgressListener& progress,
+                        const CancellationToken& cancel) {
+  const int from_index =
+      options.from_stage.empty() ? -1 : StageIndex(stages, options.from_stage);
+  if (!options.from_stage.empty() && from_index < 0) {
+    std::string names;
+    for (const PipelineStage& stage : stages) names += " " + stage.name;
+    throw UsageError("--from " + options.from_stage +
+                     ": not a stage (stages:" + names + ")");
   }
-  std::filesystem::create_directories(results_folder);
+  fs::create_directories(results_folder);
   RemoveStaleTemporaries(results_folder);
   const std::string state_path = results_folder + "/" + kRunStateFile;
   json state = ReadState(state_path);
-  if (state.value("fingerprint", "") != fingerprint) {
-    state = json{{"fingerprint", fingerprint}, {"stages", json::object()}};
+  if (!state.contains("stages") || !state["stages"].is_object()) {
+    state = json{{"stages", json::object()}};
   }
+  json& records = state["stages"];
+  const size_t first =
+      FirstStageToRun(results_folder, stages, records, from_index);
 
   PipelineRun run;
-  bool must_run = false;  // once a stage runs, every later one runs too
   for (size_t i = 0; i < stages.size(); ++i) {
     const PipelineStage& stage = stages[i];
-    json& record = state["stages"][stage.name];
-    must_run =
-        must_run || (from_index >= 0 && static_cast<int>(i) >= from_index);
-    const bool complete = record.is_object() &&
-                          record.value("complete", false) &&
-                          OutputsPresent(results_folder, stage);
-    if (!must_run && complete) {
+    json& record = records[stage.name];
+    if (i < first) {
       LOG(INFO) << stage.name << ": complete in a previous run, resumed";
       run.timings.push_back({stage.name, record.value("seconds", 0.0), true});
       for (const json& w : record.value("warnings", json::array())) {
@@ -122,17 +182,23 @@ PipelineRun RunPipeline(const std::string& results_folder,
       }
       continue;
     }
-    must_run = true;
-    // Record the stage as incomplete before it starts, so a kill during it
-    // never leaves it looking complete.
-    record = json{{"complete", false}};
+    cancel.ThrowIfCancelled();
+    // Recorded as incomplete before it starts, so a kill during it never
+    // leaves it looking complete; the stages whose outputs it rewrites no
+    // longer hold their own.
+    record = json{{"complete", false}, {"fingerprint", stage.fingerprint}};
+    for (const std::string& name : stage.rewrites) {
+      records[name]["rewritten"] = true;
+    }
     WriteState(state_path, state);
     StepProgress step(progress, stage.name);
     const std::vector<std::string> warnings = stage.run(step.Callback());
     step.Finish();
     const double seconds = step.ElapsedSeconds();
-    record =
-        json{{"complete", true}, {"seconds", seconds}, {"warnings", warnings}};
+    record = json{{"complete", true},
+                  {"fingerprint", stage.fingerprint},
+                  {"seconds", seconds},
+                  {"warnings", warnings}};
     WriteState(state_path, state);
     run.timings.push_back({stage.name, seconds, false});
     run.warnings.insert(run.warnings.end(), warnings.begin(), warnings.end());

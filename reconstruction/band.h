@@ -146,6 +146,47 @@ struct BandOptions {
   int min_end_direction_observations = 4;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_side_angle_rad", max_side_angle_rad);
+    v("min_side_overlap_fraction", min_side_overlap_fraction);
+    v("max_length_excess_m", max_length_excess_m);
+    v("extremity_length_fraction", extremity_length_fraction);
+    v("transversal_search_m", transversal_search_m);
+    v("side_margin_m", side_margin_m);
+    v("transversal_max_angle_rad", transversal_max_angle_rad);
+    v("point_angle_tolerance_rad", point_angle_tolerance_rad);
+    v("hough_angle_step_rad", hough_angle_step_rad);
+    v("hough_rho_step_px", hough_rho_step_px);
+    v("hough_score_fraction", hough_score_fraction);
+    v("pair_score_fraction", pair_score_fraction);
+    v("hough_min_gradient", hough_min_gradient);
+    v("refine_distance_px", refine_distance_px);
+    v("min_transversal_points", min_transversal_points);
+    v("max_transversal_run_on", max_transversal_run_on);
+    v("min_end_step_fraction", min_end_step_fraction);
+    v("end_step_profile_px", end_step_profile_px);
+    v("max_end_angle_rad", max_end_angle_rad);
+    v("end_angle_full_range_m", end_angle_full_range_m);
+    v("end_angle_min_share", end_angle_min_share);
+    v("max_end_disagreement_rad_per_m", max_end_disagreement_rad_per_m);
+    v("max_stereo_disagreement_m", max_stereo_disagreement_m);
+    v("max_crossing_gap_m", max_crossing_gap_m);
+    v("max_band_range_m", max_band_range_m);
+    v("min_line_sigma_px", min_line_sigma_px);
+    v("min_sigma_m", min_sigma_m);
+    v("complete_crossings", complete_crossings);
+    v("completion_min_bands", completion_min_bands);
+    v("completion_tolerance_m", completion_tolerance_m);
+    v("completion_min_sigma_m", completion_min_sigma_m);
+    v("inferred_score_factor", inferred_score_factor);
+    v("max_inferred_range_m", max_inferred_range_m);
+    v("infer_hidden_ends", infer_hidden_ends);
+    v("hidden_end_max_rms_m", hidden_end_max_rms_m);
+    v("hidden_end_max_offset_m", hidden_end_max_offset_m);
+    v("crossing_end_direction", crossing_end_direction);
+    v("min_end_direction_observations", min_end_direction_observations);
+  }
 };
 
 struct Band {

@@ -10,6 +10,7 @@
 
 #include "reconstruction/bright_lines.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -144,36 +145,30 @@ bool EndOfBand(const cv::Mat& image, const cv::Mat& valid,
 }  // namespace
 
 std::string CrossingEdgeOptions::Check() const {
-  std::ostringstream e;
-  if (!(box_window_m > 0.5)) {
-    e << "box_window_m must exceed 0.5 m";
-  } else if (!(min_contrast > 0.0)) {
-    e << "min_contrast must be positive";
-  } else if (!(min_band_width_m > 0.0 && max_band_width_m > min_band_width_m)) {
-    e << "band widths must satisfy 0 < min_band_width_m < max_band_width_m";
-  } else if (!(max_side_difference > 0.0)) {
-    e << "max_side_difference must be positive";
-  } else if (!(min_band_length_m > 0.0)) {
-    e << "min_band_length_m must be positive";
-  } else if (!(max_axis_slope > 0.0 && max_end_slope > 0.0)) {
-    e << "max_axis_slope and max_end_slope must be positive";
-  } else if (!(max_end_rms_px > 0.0) || min_end_columns < 2) {
-    e << "max_end_rms_px must be positive and min_end_columns at least 2";
-  } else if (min_bands < 2) {
-    e << "min_bands must be at least 2";
-  } else if (!(stereo_length_m > 0.0 && max_axis_rms_m > 0.0 &&
-               max_end_height_difference_m > 0.0 && max_end_range_m > 0.0) ||
-             min_stereo_rows < 3) {
-    e << "stereo_length_m, max_axis_rms_m, max_end_height_difference_m and "
-         "max_end_range_m must be positive and "
-         "min_stereo_rows at least 3";
-  } else if (!(max_band_gap_m > 0.0 && max_edge_residual_m > 0.0 &&
-               max_end_angle_rad > 0.0 && end_sigma_px > 0.0)) {
-    e << "max_band_gap_m, max_edge_residual_m, max_end_angle_rad and "
-         "end_sigma_px must be positive";
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "crossing edge options: " + error;
+  OptionCheck check;
+  OPTION_GT(check, box_window_m, 0.5);
+  OPTION_GT(check, min_contrast, 0.0);
+  OPTION_GT(check, min_band_width_m, 0.0);
+  OPTION_REQUIRE(check, max_band_width_m > min_band_width_m, max_band_width_m,
+                 "band widths must satisfy 0 < min_band_width_m < "
+                 "max_band_width_m");
+  OPTION_GT(check, max_side_difference, 0.0);
+  OPTION_GT(check, min_band_length_m, 0.0);
+  OPTION_GT(check, max_axis_slope, 0.0);
+  OPTION_GT(check, max_end_slope, 0.0);
+  OPTION_GT(check, max_end_rms_px, 0.0);
+  OPTION_GE(check, min_end_columns, 2);
+  OPTION_GE(check, min_bands, 2);
+  OPTION_GT(check, stereo_length_m, 0.0);
+  OPTION_GT(check, max_axis_rms_m, 0.0);
+  OPTION_GT(check, max_end_height_difference_m, 0.0);
+  OPTION_GT(check, max_end_range_m, 0.0);
+  OPTION_GE(check, min_stereo_rows, 3);
+  OPTION_GT(check, max_band_gap_m, 0.0);
+  OPTION_GT(check, max_edge_residual_m, 0.0);
+  OPTION_GT(check, max_end_angle_rad, 0.0);
+  OPTION_GT(check, end_sigma_px, 0.0);
+  return check.problem();
 }
 
 std::vector<BandEnd> FindBandEnds(const cv::Mat& image, const cv::Mat& valid,

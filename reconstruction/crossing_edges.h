@@ -86,6 +86,30 @@ struct CrossingEdgeOptions {
   double max_end_range_m = 11.0;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("enabled", enabled);
+    v("box_window_m", box_window_m);
+    v("min_contrast", min_contrast);
+    v("min_band_width_m", min_band_width_m);
+    v("max_band_width_m", max_band_width_m);
+    v("max_side_difference", max_side_difference);
+    v("min_band_length_m", min_band_length_m);
+    v("max_axis_slope", max_axis_slope);
+    v("max_end_slope", max_end_slope);
+    v("max_end_rms_px", max_end_rms_px);
+    v("min_end_columns", min_end_columns);
+    v("min_bands", min_bands);
+    v("max_band_gap_m", max_band_gap_m);
+    v("max_edge_residual_m", max_edge_residual_m);
+    v("max_end_angle_rad", max_end_angle_rad);
+    v("end_sigma_px", end_sigma_px);
+    v("stereo_length_m", stereo_length_m);
+    v("min_stereo_rows", min_stereo_rows);
+    v("max_axis_rms_m", max_axis_rms_m);
+    v("max_end_height_difference_m", max_end_height_difference_m);
+    v("max_end_range_m", max_end_range_m);
+  }
 };
 
 // A band end found in the rectified image.

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -232,33 +233,17 @@ class RowMatcher {
 }  // namespace
 
 std::string MatchingOptions::Check() const {
-  std::ostringstream error;
-  if (window_radius_px < 1 || window_radius_px > 15) {
-    error << "window_radius_px = " << window_radius_px
-          << ": must be in [1, 15]";
-  } else if (!(min_ncc > -1.0 && min_ncc < 1.0)) {
-    error << "min_ncc = " << min_ncc << ": must be in (-1, 1)";
-  } else if (!(occlusion_cost > 0.0)) {
-    error << "occlusion_cost = " << occlusion_cost << ": must be > 0";
-  } else if (!(max_gradient_angle_rad > 0.0 && max_gradient_angle_rad < 1.6)) {
-    error << "max_gradient_angle_rad = " << max_gradient_angle_rad
-          << ": must be in (0, 1.6)";
-  } else if (!(min_epipolar_angle_rad >= 0.0 && min_epipolar_angle_rad < 1.5)) {
-    error << "min_epipolar_angle_rad = " << min_epipolar_angle_rad
-          << ": must be in [0, 1.5)";
-  } else if (!(continuity_weight >= 0.0)) {
-    error << "continuity_weight = " << continuity_weight << ": must be >= 0";
-  } else if (!(continuity_tolerance_px > 0.0)) {
-    error << "continuity_tolerance_px = " << continuity_tolerance_px
-          << ": must be > 0";
-  } else if (continuity_half_window < 1) {
-    error << "continuity_half_window = " << continuity_half_window
-          << ": must be >= 1";
-  } else if (min_matches_per_chain < 1) {
-    error << "min_matches_per_chain = " << min_matches_per_chain
-          << ": must be >= 1";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_IN(check, window_radius_px, "[", 1, 15, "]");
+  OPTION_IN(check, min_ncc, "(", -1.0, 1.0, ")");
+  OPTION_GT(check, occlusion_cost, 0.0);
+  OPTION_IN(check, max_gradient_angle_rad, "(", 0.0, 1.6, ")");
+  OPTION_IN(check, min_epipolar_angle_rad, "[", 0.0, 1.5, ")");
+  OPTION_GE(check, continuity_weight, 0.0);
+  OPTION_GT(check, continuity_tolerance_px, 0.0);
+  OPTION_GE(check, continuity_half_window, 1);
+  OPTION_GE(check, min_matches_per_chain, 1);
+  return check.problem();
 }
 
 double ChainCrossing(const EdgeMap& edges, int j, double y) {

@@ -50,6 +50,18 @@ struct MatchingOptions {
   int min_matches_per_chain = 5;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("window_radius_px", window_radius_px);
+    v("min_ncc", min_ncc);
+    v("occlusion_cost", occlusion_cost);
+    v("max_gradient_angle_rad", max_gradient_angle_rad);
+    v("min_epipolar_angle_rad", min_epipolar_angle_rad);
+    v("continuity_weight", continuity_weight);
+    v("continuity_tolerance_px", continuity_tolerance_px);
+    v("continuity_half_window", continuity_half_window);
+    v("min_matches_per_chain", min_matches_per_chain);
+  }
 };
 
 struct EdgeMatch {

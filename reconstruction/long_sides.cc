@@ -10,6 +10,7 @@
 
 #include "reconstruction/segment_grouping.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -19,66 +20,35 @@ constexpr int kDirectionBins = 180;
 }  // namespace
 
 std::string ZebraSpecification::Check() const {
-  std::ostringstream error;
-  if (!(band_width_m > 0.05)) {
-    error << "band_width_m = " << band_width_m << ": must be > 0.05";
-  } else if (!(band_width_tolerance_m > 0.0 &&
-               band_width_tolerance_m < band_width_m)) {
-    error << "band_width_tolerance_m = " << band_width_tolerance_m
-          << ": must be in (0, band_width_m)";
-  } else if (!(min_band_length_m > band_width_m)) {
-    error << "min_band_length_m = " << min_band_length_m
-          << ": must be > band_width_m";
-  } else if (!(max_band_length_m >= min_band_length_m)) {
-    error << "max_band_length_m = " << max_band_length_m
-          << ": must be >= min_band_length_m";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_GT(check, band_width_m, 0.05);
+  OPTION_GT(check, band_width_tolerance_m, 0.0);
+  OPTION_LT(check, band_width_tolerance_m, band_width_m);
+  OPTION_GT(check, min_band_length_m, band_width_m);
+  OPTION_GE(check, max_band_length_m, min_band_length_m);
+  return check.problem();
 }
 
 std::string LongSideOptions::Check() const {
-  std::ostringstream error;
-  if (!(polygon_tolerance_m > 0.0)) {
-    error << "polygon_tolerance_m = " << polygon_tolerance_m << ": must be > 0";
-  } else if (!(max_chain_gap_m > 0.0)) {
-    error << "max_chain_gap_m = " << max_chain_gap_m << ": must be > 0";
-  } else if (!(min_segment_length_m > 0.0)) {
-    error << "min_segment_length_m = " << min_segment_length_m
-          << ": must be > 0";
-  } else if (!(direction_tolerance_rad > 0.0 &&
-               direction_tolerance_rad < 0.8)) {
-    error << "direction_tolerance_rad = " << direction_tolerance_rad
-          << ": must be in (0, 0.8)";
-  } else if (max_directions < 1) {
-    error << "max_directions = " << max_directions << ": must be >= 1";
-  } else if (!(accumulator_cell_m > 0.0)) {
-    error << "accumulator_cell_m = " << accumulator_cell_m << ": must be > 0";
-  } else if (!(high_vote_fraction > 0.0 &&
-               high_vote_fraction >= low_vote_fraction)) {
-    error << "high_vote_fraction = " << high_vote_fraction
-          << ": must be > 0 and >= low_vote_fraction";
-  } else if (!(low_vote_fraction > 0.0)) {
-    error << "low_vote_fraction = " << low_vote_fraction << ": must be > 0";
-  } else if (!(pass1_max_gap_m > 0.0 && pass1_max_offset_m > 0.0 &&
-               pass1_max_angle_rad > 0.0)) {
-    error << "pass1_max_gap_m, pass1_max_offset_m, pass1_max_angle_rad = "
-          << pass1_max_gap_m << ", " << pass1_max_offset_m << ", "
-          << pass1_max_angle_rad << ": must be > 0";
-  } else if (!(pass2_max_gap_m > 0.0 && pass2_max_offset_m > 0.0 &&
-               pass2_max_angle_rad > 0.0)) {
-    error << "pass2_max_gap_m, pass2_max_offset_m, pass2_max_angle_rad = "
-          << pass2_max_gap_m << ", " << pass2_max_offset_m << ", "
-          << pass2_max_angle_rad << ": must be > 0";
-  } else if (!(pass1_min_length_m >= 0.0)) {
-    error << "pass1_min_length_m = " << pass1_min_length_m << ": must be >= 0";
-  } else if (!(min_long_side_length_m > 0.0)) {
-    error << "min_long_side_length_m = " << min_long_side_length_m
-          << ": must be > 0";
-  } else if (height_smoothing_half_window < 0) {
-    error << "height_smoothing_half_window = " << height_smoothing_half_window
-          << ": must be >= 0";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_GT(check, polygon_tolerance_m, 0.0);
+  OPTION_GT(check, max_chain_gap_m, 0.0);
+  OPTION_GT(check, min_segment_length_m, 0.0);
+  OPTION_IN(check, direction_tolerance_rad, "(", 0.0, 0.8, ")");
+  OPTION_GE(check, max_directions, 1);
+  OPTION_GT(check, accumulator_cell_m, 0.0);
+  OPTION_GT(check, low_vote_fraction, 0.0);
+  OPTION_GE(check, high_vote_fraction, low_vote_fraction);
+  OPTION_GT(check, pass1_max_gap_m, 0.0);
+  OPTION_GT(check, pass1_max_offset_m, 0.0);
+  OPTION_GT(check, pass1_max_angle_rad, 0.0);
+  OPTION_GT(check, pass2_max_gap_m, 0.0);
+  OPTION_GT(check, pass2_max_offset_m, 0.0);
+  OPTION_GT(check, pass2_max_angle_rad, 0.0);
+  OPTION_GE(check, pass1_min_length_m, 0.0);
+  OPTION_GT(check, min_long_side_length_m, 0.0);
+  OPTION_GE(check, height_smoothing_half_window, 0);
+  return check.problem();
 }
 
 void RegulariseChainHeights(const RoadPlane& road,

@@ -38,6 +38,13 @@ struct ZebraSpecification {
   double max_band_length_m = 6.0;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("band_width_m", band_width_m);
+    v("band_width_tolerance_m", band_width_tolerance_m);
+    v("min_band_length_m", min_band_length_m);
+    v("max_band_length_m", max_band_length_m);
+  }
 };
 
 struct LongSideOptions {
@@ -76,6 +83,26 @@ struct LongSideOptions {
   int height_smoothing_half_window = 25;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("polygon_tolerance_m", polygon_tolerance_m);
+    v("max_chain_gap_m", max_chain_gap_m);
+    v("min_segment_length_m", min_segment_length_m);
+    v("direction_tolerance_rad", direction_tolerance_rad);
+    v("max_directions", max_directions);
+    v("accumulator_cell_m", accumulator_cell_m);
+    v("high_vote_fraction", high_vote_fraction);
+    v("low_vote_fraction", low_vote_fraction);
+    v("pass1_max_gap_m", pass1_max_gap_m);
+    v("pass1_max_offset_m", pass1_max_offset_m);
+    v("pass1_max_angle_rad", pass1_max_angle_rad);
+    v("pass1_min_length_m", pass1_min_length_m);
+    v("pass2_max_gap_m", pass2_max_gap_m);
+    v("pass2_max_offset_m", pass2_max_offset_m);
+    v("pass2_max_angle_rad", pass2_max_angle_rad);
+    v("min_long_side_length_m", min_long_side_length_m);
+    v("height_smoothing_half_window", height_smoothing_half_window);
+  }
 };
 
 // A 2D frame on the road plane.

@@ -15,6 +15,7 @@
 #include "reconstruction/debug_images.h"
 #include "survey/image_io.h"
 #include "survey/input_error.h"
+#include "survey/option_check.h"
 #include "survey/threads.h"
 
 namespace zebrageo {
@@ -84,18 +85,18 @@ std::vector<EdgeChain3d> ChainsNearRoad(
 }  // namespace
 
 std::string ReconstructionOptions::Check() const {
-  for (const std::string& error :
-       {rectification.Check(), edges.Check(), matching.Check(), search.Check(),
-        road_plane.Check(), zebra.Check(), long_sides.Check(), bands.Check()}) {
-    if (!error.empty()) return error;
-  }
-  std::ostringstream error;
-  if (threads < 0) {
-    error << "threads = " << threads << ": must be >= 0";
-  } else if (batch_exposures < 1) {
-    error << "batch_exposures = " << batch_exposures << ": must be >= 1";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_NESTED(check, rectification);
+  OPTION_NESTED(check, edges);
+  OPTION_NESTED(check, matching);
+  OPTION_NESTED(check, search);
+  OPTION_NESTED(check, road_plane);
+  OPTION_NESTED(check, zebra);
+  OPTION_NESTED(check, long_sides);
+  OPTION_NESTED(check, bands);
+  OPTION_GE(check, threads, 0);
+  OPTION_GE(check, batch_exposures, 1);
+  return check.problem();
 }
 
 double StepTimings::Total() const {
@@ -376,7 +377,8 @@ RoadPlane InitialRoadPlane(const Survey& survey, const StereoPairs& pairs,
 std::vector<ExposureResult> ProcessExposures(
     const Survey& survey, const StereoPairs& pairs,
     const ReconstructionOptions& options, int threads,
-    const ProgressCallback& progress, RoadPlaneTracker* running) {
+    const ProgressCallback& progress, const CancellationToken& cancel,
+    RoadPlaneTracker* running) {
   const std::vector<Exposure>& exposures = survey.exposures.exposures;
   std::vector<ExposureResult> results(exposures.size());
   std::mutex progress_mutex;
@@ -386,6 +388,7 @@ std::vector<ExposureResult> ProcessExposures(
     const int end = std::min(total, begin + options.batch_exposures);
     const RoadPlane prior = running->plane();
     ParallelFor(end - begin, threads, [&](int k) {
+      cancel.ThrowIfCancelled();  // between exposures
       results[begin + k] =
           ProcessExposure(survey, exposures[begin + k], pairs, options, prior,
                           options.search.slab_half_thickness_m,
@@ -485,7 +488,7 @@ void AppendVertices(const std::vector<Exposure>& exposures,
 ReconstructionSummary ReconstructSurvey(
     const Survey& survey, const ReconstructionOptions& options,
     std::vector<ReconstructedVertex>* vertices,
-    const ProgressCallback& progress) {
+    const ProgressCallback& progress, const CancellationToken& cancel) {
   const Clock::time_point wall_start = Clock::now();
   ReconstructionSummary summary;
   summary.message = options.Check();
@@ -520,8 +523,8 @@ ReconstructionSummary ReconstructSurvey(
   summary.initial_road_plane = initial;
   pairs = MakePairs(rig, initial, options, &summary);
   RoadPlaneTracker running(initial, options.search);
-  const std::vector<ExposureResult> results =
-      ProcessExposures(survey, pairs, options, threads, progress, &running);
+  const std::vector<ExposureResult> results = ProcessExposures(
+      survey, pairs, options, threads, progress, cancel, &running);
   summary.final_road_plane = running.plane();
   AppendVertices(exposures, results, pairs, &summary, vertices);
   summary.wall_time_s = SecondsSince(wall_start);

@@ -42,6 +42,7 @@
 #include "reconstruction/road_rectification.h"
 #include "reconstruction/search_volume.h"
 #include "reconstruction/subpixel_edges.h"
+#include "survey/cancellation.h"
 #include "survey/results.h"
 #include "survey/rig.h"
 #include "survey/survey.h"
@@ -70,6 +71,21 @@ struct ReconstructionOptions {
   uint64_t seed = 1;  // RANSAC
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("rectification", rectification);
+    v("edges", edges);
+    v("matching", matching);
+    v("search", search);
+    v("road_plane", road_plane);
+    v("zebra", zebra);
+    v("long_sides", long_sides);
+    v("bands", bands);
+    v("threads", threads);
+    v("batch_exposures", batch_exposures);
+    v("debug_image_folder", debug_image_folder);
+    v("seed", seed);
+  }
 };
 
 // Seconds spent in each step, summed over stereo pairs (CPU time of the
@@ -169,7 +185,8 @@ using ProgressCallback = std::function<void(int, int)>;
 ReconstructionSummary ReconstructSurvey(
     const Survey& survey, const ReconstructionOptions& options,
     std::vector<ReconstructedVertex>* vertices,
-    const ProgressCallback& progress = nullptr);
+    const ProgressCallback& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "survey/image_io.h"
+#include "survey/option_check.h"
 #include "survey/threads.h"
 
 namespace zebrageo {
@@ -156,57 +157,43 @@ double PolylineLength(const std::vector<Eigen::Vector3d>& points) {
 }  // namespace
 
 std::string RoadLineOptions::Check() const {
-  std::ostringstream e;
-  if (!(ground_pixel_m > 0.002 && ground_pixel_m < 0.2)) {
-    e << "ground_pixel_m must be in (0.002, 0.2) m";
-  } else if (!(max_range_m > 1.0) || !(max_lateral_m > 0.5)) {
-    e << "max_range_m must exceed 1 m and max_lateral_m 0.5 m";
-  } else if (median_window_px < 1 || median_window_px % 2 == 0) {
-    e << "median_window_px must be odd and positive";
-  } else if (!(background_window_m == 0.0 ||
-               (background_window_m >= 2.0 * max_line_width_m &&
-                background_window_m <= 10.0))) {
-    e << "background_window_m must be 0 or in [2 x max_line_width_m, 10] m";
-  } else if (!(max_break_m >= 0.0 && max_break_m <= 2.0) ||
-             !(max_break_offset_m > 0.0 && max_break_offset_m <= 0.5)) {
-    e << "max_break_m must be in [0, 2] m and max_break_offset_m in (0, 0.5]";
-  } else if (!(min_end_contrast >= 0.0)) {
-    e << "min_end_contrast must be >= 0";
-  } else if (!(local_threshold_sigmas > 0.0) || !(shadow_sigmas > 0.0)) {
-    e << "local_threshold_sigmas and shadow_sigmas must be positive";
-  } else if (!(threshold_sigmas > 0.0)) {
-    e << "threshold_sigmas must be positive";
-  } else if (!(min_line_width_m > 0.0 && max_line_width_m > min_line_width_m)) {
-    e << "need 0 < min_line_width_m < max_line_width_m";
-  } else if (!(min_stop_line_width_m > 0.0 &&
-               max_stop_line_width_m > min_stop_line_width_m)) {
-    e << "need 0 < min_stop_line_width_m < max_stop_line_width_m";
-  } else if (!(max_side_difference > 0.0)) {
-    e << "max_side_difference must be positive";
-  } else if (min_chain_px < 2) {
-    e << "min_chain_px must be at least 2";
-  } else if (!(min_stop_line_length_m >= 0.0)) {
-    e << "min_stop_line_length_m must not be negative";
-  } else if (!(collinear_tolerance_px > 0.0) ||
-             !(max_vertex_spacing_m > ground_pixel_m)) {
-    e << "collinear_tolerance_px must be positive and max_vertex_spacing_m "
-         "larger than a pixel";
-  } else if (!(max_height_off_road_m > 0.0)) {
-    e << "max_height_off_road_m must be positive";
-  } else if (!(centre_sigma_px > 0.0) || !(correlation_px >= 1.0)) {
-    e << "centre_sigma_px must be positive and correlation_px at least 1";
-  } else if (vertex_half_window_px < 0 || min_vertex_points < 1) {
-    e << "vertex_half_window_px must not be negative, min_vertex_points "
-         "positive";
-  } else if (!(max_dash_length_m > 0.0)) {
-    e << "max_dash_length_m must be positive";
-  } else if (!(stop_line_height_sigma_m > 0.0)) {
-    e << "stop_line_height_sigma_m must be positive";
-  } else if (crossing_edges.enabled) {
-    e << crossing_edges.Check();
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "road line options: " + error;
+  OptionCheck check;
+  OPTION_IN(check, ground_pixel_m, "(", 0.002, 0.2, ")");
+  OPTION_GT(check, max_range_m, 1.0);
+  OPTION_GT(check, max_lateral_m, 0.5);
+  OPTION_GE(check, median_window_px, 1);
+  OPTION_REQUIRE(check, median_window_px % 2 == 1, median_window_px,
+                 "must be odd");
+  OPTION_REQUIRE(check,
+                 background_window_m == 0.0 ||
+                     (background_window_m >= 2.0 * max_line_width_m &&
+                      background_window_m <= 10.0),
+                 background_window_m,
+                 "must be 0 or in [2 x max_line_width_m, 10]");
+  OPTION_IN(check, max_break_m, "[", 0.0, 2.0, "]");
+  OPTION_IN(check, max_break_offset_m, "(", 0.0, 0.5, "]");
+  OPTION_GE(check, min_end_contrast, 0.0);
+  OPTION_GT(check, local_threshold_sigmas, 0.0);
+  OPTION_GT(check, shadow_sigmas, 0.0);
+  OPTION_GT(check, threshold_sigmas, 0.0);
+  OPTION_GT(check, min_line_width_m, 0.0);
+  OPTION_GT(check, max_line_width_m, min_line_width_m);
+  OPTION_GT(check, min_stop_line_width_m, 0.0);
+  OPTION_GT(check, max_stop_line_width_m, min_stop_line_width_m);
+  OPTION_GT(check, max_side_difference, 0.0);
+  OPTION_GE(check, min_chain_px, 2);
+  OPTION_GE(check, min_stop_line_length_m, 0.0);
+  OPTION_GT(check, collinear_tolerance_px, 0.0);
+  OPTION_GT(check, max_vertex_spacing_m, ground_pixel_m);
+  OPTION_GT(check, max_height_off_road_m, 0.0);
+  OPTION_GT(check, centre_sigma_px, 0.0);
+  OPTION_GE(check, correlation_px, 1.0);
+  OPTION_GE(check, vertex_half_window_px, 0);
+  OPTION_GE(check, min_vertex_points, 1);
+  OPTION_GT(check, max_dash_length_m, 0.0);
+  OPTION_GT(check, stop_line_height_sigma_m, 0.0);
+  if (crossing_edges.enabled) OPTION_NESTED(check, crossing_edges);
+  return check.problem();
 }
 
 StereoLineExtractor::StereoLineExtractor(const RigCamera& left,
@@ -442,7 +429,8 @@ std::string RoadLineSummary::BriefReport() const {
 RoadLineSummary ExtractSurveyLines(
     const Survey& survey, const RoadPlane& road, const RoadLineOptions& options,
     int threads, std::vector<ReconstructedLinePoint>* points,
-    const std::function<void(int, int)>& progress) {
+    const std::function<void(int, int)>& progress,
+    const CancellationToken& cancel) {
   RoadLineSummary summary;
   const Rig& rig = survey.rig;
   std::vector<std::unique_ptr<StereoLineExtractor>> extractors;
@@ -470,6 +458,7 @@ RoadLineSummary ExtractSurveyLines(
   }
   PrepareImageCodecs();  // before the worker threads read images
   ParallelFor(total, threads, [&](int e) {
+    cancel.ThrowIfCancelled();  // between exposures
     const Exposure& exposure = exposures[e];
     results[e].resize(extractors.size());
     ran[e].assign(extractors.size(), false);

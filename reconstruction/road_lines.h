@@ -55,6 +55,7 @@
 #include "reconstruction/bright_lines.h"
 #include "reconstruction/crossing_edges.h"
 #include "reconstruction/road_rectification.h"
+#include "survey/cancellation.h"
 #include "survey/results_lines.h"
 #include "survey/rig.h"
 #include "survey/survey.h"
@@ -144,6 +145,39 @@ struct RoadLineOptions {
   CrossingEdgeOptions crossing_edges;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("ground_pixel_m", ground_pixel_m);
+    v("max_range_m", max_range_m);
+    v("max_lateral_m", max_lateral_m);
+    v("median_window_px", median_window_px);
+    v("threshold_sigmas", threshold_sigmas);
+    v("plain_statistics", plain_statistics);
+    v("background_window_m", background_window_m);
+    v("local_threshold_sigmas", local_threshold_sigmas);
+    v("shadow_sigmas", shadow_sigmas);
+    v("min_line_width_m", min_line_width_m);
+    v("max_line_width_m", max_line_width_m);
+    v("min_stop_line_width_m", min_stop_line_width_m);
+    v("max_stop_line_width_m", max_stop_line_width_m);
+    v("max_side_difference", max_side_difference);
+    v("min_chain_px", min_chain_px);
+    v("max_break_m", max_break_m);
+    v("max_break_offset_m", max_break_offset_m);
+    v("half_contrast_ends", half_contrast_ends);
+    v("min_end_contrast", min_end_contrast);
+    v("min_stop_line_length_m", min_stop_line_length_m);
+    v("collinear_tolerance_px", collinear_tolerance_px);
+    v("max_vertex_spacing_m", max_vertex_spacing_m);
+    v("max_height_off_road_m", max_height_off_road_m);
+    v("centre_sigma_px", centre_sigma_px);
+    v("correlation_px", correlation_px);
+    v("vertex_half_window_px", vertex_half_window_px);
+    v("min_vertex_points", min_vertex_points);
+    v("max_dash_length_m", max_dash_length_m);
+    v("stop_line_height_sigma_m", stop_line_height_sigma_m);
+    v("crossing_edges", crossing_edges);
+  }
 };
 
 // --- A stereo pair -----------------------------------------------------------
@@ -228,7 +262,8 @@ struct RoadLineSummary {
 RoadLineSummary ExtractSurveyLines(
     const Survey& survey, const RoadPlane& road, const RoadLineOptions& options,
     int threads, std::vector<ReconstructedLinePoint>* points,
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

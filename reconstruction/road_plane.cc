@@ -5,6 +5,8 @@
 #include <random>
 #include <sstream>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 
 bool RoadPlane::IntersectRay(const Eigen::Vector3d& origin,
@@ -19,21 +21,13 @@ bool RoadPlane::IntersectRay(const Eigen::Vector3d& origin,
 }
 
 std::string RoadPlaneOptions::Check() const {
-  std::ostringstream error;
-  if (!(ransac_tolerance_m > 0.0)) {
-    error << "ransac_tolerance_m = " << ransac_tolerance_m << ": must be > 0";
-  } else if (ransac_iterations < 1) {
-    error << "ransac_iterations = " << ransac_iterations << ": must be >= 1";
-  } else if (!(keep_distance_m > 0.0)) {
-    error << "keep_distance_m = " << keep_distance_m << ": must be > 0";
-  } else if (!(max_normal_deviation_rad > 0.0 &&
-               max_normal_deviation_rad < 1.5)) {
-    error << "max_normal_deviation_rad = " << max_normal_deviation_rad
-          << ": must be in (0, 1.5)";
-  } else if (min_inliers < 3) {
-    error << "min_inliers = " << min_inliers << ": must be >= 3";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_GT(check, ransac_tolerance_m, 0.0);
+  OPTION_GE(check, ransac_iterations, 1);
+  OPTION_GT(check, keep_distance_m, 0.0);
+  OPTION_IN(check, max_normal_deviation_rad, "(", 0.0, 1.5, ")");
+  OPTION_GE(check, min_inliers, 3);
+  return check.problem();
 }
 
 bool FitPlaneLeastSquares(const std::vector<Eigen::Vector3d>& points,

@@ -48,6 +48,14 @@ struct RoadPlaneOptions {
   int min_inliers = 30;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("ransac_tolerance_m", ransac_tolerance_m);
+    v("ransac_iterations", ransac_iterations);
+    v("keep_distance_m", keep_distance_m);
+    v("max_normal_deviation_rad", max_normal_deviation_rad);
+    v("min_inliers", min_inliers);
+  }
 };
 
 struct RoadPlaneFit {

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <vector>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -98,19 +100,13 @@ bool CommonRoadFootprint(const RigCamera* const cameras[2],
 }  // namespace
 
 std::string RectificationOptions::Check() const {
-  std::ostringstream error;
-  if (!(ground_pixel_m > 0.0 && ground_pixel_m <= 0.2)) {
-    error << "ground_pixel_m = " << ground_pixel_m << ": must be in (0, 0.2]";
-  } else if (!(max_range_m > 1.0)) {
-    error << "max_range_m = " << max_range_m << ": must be > 1";
-  } else if (!(max_lateral_m > 0.5)) {
-    error << "max_lateral_m = " << max_lateral_m << ": must be > 0.5";
-  } else if (max_image_side_px < 64) {
-    error << "max_image_side_px = " << max_image_side_px << ": must be >= 64";
-  } else if (border_margin_px < 0) {
-    error << "border_margin_px = " << border_margin_px << ": must be >= 0";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_IN(check, ground_pixel_m, "(", 0.0, 0.2, "]");
+  OPTION_GT(check, max_range_m, 1.0);
+  OPTION_GT(check, max_lateral_m, 0.5);
+  OPTION_GE(check, max_image_side_px, 64);
+  OPTION_GE(check, border_margin_px, 0);
+  return check.problem();
 }
 
 bool RoadRectification::Build(const RigCamera& left, const RigCamera& right,

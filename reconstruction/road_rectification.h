@@ -50,6 +50,14 @@ struct RectificationOptions {
   int border_margin_px = 4;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("ground_pixel_m", ground_pixel_m);
+    v("max_range_m", max_range_m);
+    v("max_lateral_m", max_lateral_m);
+    v("max_image_side_px", max_image_side_px);
+    v("border_margin_px", border_margin_px);
+  }
 };
 
 class RoadRectification {

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -16,39 +17,21 @@ double AngleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }  // namespace
 
 std::string SearchVolumeOptions::Check() const {
-  std::ostringstream error;
-  if (!(std::abs(nominal_road_normal_body.norm() - 1.0) < 1e-3)) {
-    error << "nominal_road_normal_body = ["
-          << nominal_road_normal_body.transpose() << "]: must be a unit vector";
-  } else if (!(nominal_camera_height_m > 0.0)) {
-    error << "nominal_camera_height_m = " << nominal_camera_height_m
-          << ": must be > 0";
-  } else if (!(initial_slab_half_thickness_m > 0.0 &&
-               initial_slab_half_thickness_m < nominal_camera_height_m)) {
-    error << "initial_slab_half_thickness_m = " << initial_slab_half_thickness_m
-          << ": must be in (0, nominal_camera_height_m)";
-  } else if (!(initial_tolerance_angle_rad >= 0.0 &&
-               initial_tolerance_angle_rad < 0.5)) {
-    error << "initial_tolerance_angle_rad = " << initial_tolerance_angle_rad
-          << ": must be in [0, 0.5)";
-  } else if (initialization_exposures < 1) {
-    error << "initialization_exposures = " << initialization_exposures
-          << ": must be >= 1";
-  } else if (!(slab_half_thickness_m > 0.0)) {
-    error << "slab_half_thickness_m = " << slab_half_thickness_m
-          << ": must be > 0";
-  } else if (!(tolerance_angle_rad >= 0.0 && tolerance_angle_rad < 0.5)) {
-    error << "tolerance_angle_rad = " << tolerance_angle_rad
-          << ": must be in [0, 0.5)";
-  } else if (running_window < 1) {
-    error << "running_window = " << running_window << ": must be >= 1";
-  } else if (!(max_plane_change_rad > 0.0)) {
-    error << "max_plane_change_rad = " << max_plane_change_rad
-          << ": must be > 0";
-  } else if (!(max_plane_change_m > 0.0)) {
-    error << "max_plane_change_m = " << max_plane_change_m << ": must be > 0";
-  }
-  return error.str();
+  OptionCheck check;
+  check.Require(std::abs(nominal_road_normal_body.norm() - 1.0) < 1e-3,
+                "nominal_road_normal_body", nominal_road_normal_body.norm(),
+                "must be a unit vector (its norm is shown)");
+  OPTION_GT(check, nominal_camera_height_m, 0.0);
+  OPTION_GT(check, initial_slab_half_thickness_m, 0.0);
+  OPTION_LT(check, initial_slab_half_thickness_m, nominal_camera_height_m);
+  OPTION_IN(check, initial_tolerance_angle_rad, "[", 0.0, 0.5, ")");
+  OPTION_GE(check, initialization_exposures, 1);
+  OPTION_GT(check, slab_half_thickness_m, 0.0);
+  OPTION_IN(check, tolerance_angle_rad, "[", 0.0, 0.5, ")");
+  OPTION_GE(check, running_window, 1);
+  OPTION_GT(check, max_plane_change_rad, 0.0);
+  OPTION_GT(check, max_plane_change_m, 0.0);
+  return check.problem();
 }
 
 DisparityRange SlabDisparities(const RoadRectification& rectification,

@@ -48,6 +48,19 @@ struct SearchVolumeOptions {
   double max_plane_change_m = 0.15;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("nominal_road_normal_body", nominal_road_normal_body);
+    v("nominal_camera_height_m", nominal_camera_height_m);
+    v("initial_slab_half_thickness_m", initial_slab_half_thickness_m);
+    v("initial_tolerance_angle_rad", initial_tolerance_angle_rad);
+    v("initialization_exposures", initialization_exposures);
+    v("slab_half_thickness_m", slab_half_thickness_m);
+    v("tolerance_angle_rad", tolerance_angle_rad);
+    v("running_window", running_window);
+    v("max_plane_change_rad", max_plane_change_rad);
+    v("max_plane_change_m", max_plane_change_m);
+  }
 };
 
 // The residual disparities of the slab around `prior` (half-thickness

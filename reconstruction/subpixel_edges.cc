@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -71,19 +73,12 @@ int ForwardNeighbour(const std::vector<EdgePoint>& points, const cv::Mat& index,
 }  // namespace
 
 std::string EdgeOptions::Check() const {
-  std::ostringstream error;
-  if (!(gaussian_sigma_px >= 0.3 && gaussian_sigma_px <= 10.0)) {
-    error << "gaussian_sigma_px = " << gaussian_sigma_px
-          << ": must be in [0.3, 10]";
-  } else if (!(low_threshold > 0.0)) {
-    error << "low_threshold = " << low_threshold << ": must be > 0";
-  } else if (!(high_threshold >= low_threshold)) {
-    error << "high_threshold = " << high_threshold
-          << ": must be >= low_threshold (" << low_threshold << ")";
-  } else if (min_chain_points < 2) {
-    error << "min_chain_points = " << min_chain_points << ": must be >= 2";
-  }
-  return error.str();
+  OptionCheck check;
+  OPTION_IN(check, gaussian_sigma_px, "[", 0.3, 10.0, "]");
+  OPTION_GT(check, low_threshold, 0.0);
+  OPTION_GE(check, high_threshold, low_threshold);
+  OPTION_GE(check, min_chain_points, 2);
+  return check.problem();
 }
 
 bool EdgeMap::IsUsable(double x, double y) const {

@@ -38,6 +38,13 @@ struct EdgeOptions {
   int min_chain_points = 6;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("gaussian_sigma_px", gaussian_sigma_px);
+    v("high_threshold", high_threshold);
+    v("low_threshold", low_threshold);
+    v("min_chain_points", min_chain_points);
+  }
 };
 
 struct EdgePoint {

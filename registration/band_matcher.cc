@@ -10,15 +10,16 @@
 #include <string>
 
 #include "registration/band_matcher_internal.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
 
-using band_matcher_internal::Fixed;
 using band_matcher_internal::MatchState;
 
 MatchResult RunSteps(const MatchInput& input, const MatchOptions& options,
-                     const std::function<void(int, int)>& progress) {
+                     const std::function<void(int, int)>& progress,
+                     const CancellationToken& cancel) {
   namespace internal = band_matcher_internal;
   const auto start = std::chrono::steady_clock::now();
   MatchState state(input, options);
@@ -33,6 +34,7 @@ MatchResult RunSteps(const MatchInput& input, const MatchOptions& options,
   state.unbeaten_offsets.assign(n, {});
   state.evidence.assign(n, ObservationEvidence());
   for (int o = 0; o < n; ++o) {
+    cancel.ThrowIfCancelled();
     const CrossingObservation& source = input.observations[o];
     ObservationEvidence& ev = state.evidence[o];
     ev.exposure_id = source.exposure_id;
@@ -72,119 +74,52 @@ MatchResult RunSteps(const MatchInput& input, const MatchOptions& options,
 }  // namespace
 
 std::string MatchOptions::Check() const {
-  std::ostringstream out;
-  auto positive = [&](const char* name, double value) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      out << name << " = " << value << ": must be > 0";
-      return false;
-    }
-    return true;
-  };
-  auto non_negative = [&](const char* name, double value) {
-    if (!(value >= 0.0) || !std::isfinite(value)) {
-      out << name << " = " << value << ": must be >= 0";
-      return false;
-    }
-    return true;
-  };
-  if (!positive("max_drift_m", max_drift_m) ||
-      !non_negative("sd_gate_factor", sd_gate_factor) ||
-      !non_negative("max_cross_track_m", max_cross_track_m) ||
-      !positive("max_heading_error_rad", max_heading_error_rad) ||
-      !positive("min_band_length_m", min_band_length_m) ||
-      !positive("max_band_length_m", max_band_length_m) ||
-      !positive("min_band_width_m", min_band_width_m) ||
-      !positive("max_band_width_m", max_band_width_m) ||
-      !positive("max_length_difference_m", max_length_difference_m) ||
-      !positive("max_width_difference_m", max_width_difference_m) ||
-      !positive("hit_tolerance_m", hit_tolerance_m) ||
-      !positive("vertex_tolerance_m", vertex_tolerance_m) ||
-      !non_negative("missing_band_weight", missing_band_weight) ||
-      !positive("max_missing_views", max_missing_views) ||
-      !non_negative("contradiction_weight", contradiction_weight) ||
-      !non_negative("unexplained_band_weight", unexplained_band_weight) ||
-      !non_negative("visibility_margin_px", visibility_margin_px) ||
-      !non_negative("visibility_safety_px", visibility_safety_px) ||
-      !non_negative("visibility_range_m", visibility_range_m) ||
-      !non_negative("window_s", window_s) ||
-      !positive("same_correction_tolerance_m", same_correction_tolerance_m) ||
-      !non_negative("drift_rate_m_per_s", drift_rate_m_per_s) ||
-      !positive("min_margin", min_margin) ||
-      !non_negative("min_strong_margin", min_strong_margin) ||
-      !positive("probe_range_m", probe_range_m) ||
-      !non_negative("neighbour_window_s", neighbour_window_s) ||
-      !positive("neighbour_tolerance_m", neighbour_tolerance_m) ||
-      !non_negative("max_drift_rate_m_per_s", max_drift_rate_m_per_s) ||
-      !positive("max_informative_tolerance_m", max_informative_tolerance_m) ||
-      !non_negative("resolve_base_m", resolve_base_m) ||
-      !non_negative("max_drift_per_metre", max_drift_per_metre) ||
-      !non_negative("max_drift_acceleration_m_per_s2",
-                    max_drift_acceleration_m_per_s2) ||
-      !non_negative("max_resolve_bound_m", max_resolve_bound_m) ||
-      !non_negative("max_exclusion_bound_m", max_exclusion_bound_m) ||
-      !positive("max_sd_ratio", max_sd_ratio) ||
-      !positive("shifted_crossing_threshold_m", shifted_crossing_threshold_m)) {
-    return out.str();
-  }
-  if (max_heading_error_rad >= 0.5) {
-    out << "max_heading_error_rad = " << max_heading_error_rad
-        << ": must be < 0.5 (bands would pair with crossings of other roads)";
-    return out.str();
-  }
-  if (min_band_length_m >= max_band_length_m) {
-    out << "min_band_length_m = " << min_band_length_m
-        << ": must be < max_band_length_m = " << max_band_length_m;
-    return out.str();
-  }
-  if (min_band_width_m >= max_band_width_m) {
-    out << "min_band_width_m = " << min_band_width_m
-        << ": must be < max_band_width_m = " << max_band_width_m;
-    return out.str();
-  }
-  if (hit_tolerance_m >= 0.5) {
-    out << "hit_tolerance_m = " << hit_tolerance_m
-        << ": must be < 0.5 (half the band period, or neighbouring bands "
-           "would explain each other)";
-    return out.str();
-  }
-  if (min_hit_bands < 1) {
-    out << "min_hit_bands = " << min_hit_bands << ": must be >= 1";
-    return out.str();
-  }
-  if (min_views_for_fault < 1) {
-    out << "min_views_for_fault = " << min_views_for_fault << ": must be >= 1";
-    return out.str();
-  }
-  return "";
-}
-
-const char* FaultKindName(FaultKind kind) {
-  switch (kind) {
-    case FaultKind::kCrossingMissingFromDatabase:
-      return "crossing_missing_from_database";
-    case FaultKind::kCrossingGoneFromStreet:
-      return "crossing_gone_from_street";
-    case FaultKind::kBandMissingFromStreet:
-      return "band_missing_from_street";
-    case FaultKind::kBandMissingFromDatabase:
-      return "band_missing_from_database";
-    case FaultKind::kCrossingShifted:
-      return "crossing_shifted";
-  }
-  return "unknown";
-}
-
-std::string MatchSummary::BriefReport() const {
-  std::ostringstream out;
-  if (!IsUsable()) return "match: not run: " + message;
-  out << "match: " << observations << " observations: " << matched
-      << " matched (" << resolved_by_neighbours << " by continuity), "
-      << refused << " refused (" << ambiguous << " ambiguous, " << inconsistent
-      << " inconsistent), " << no_candidate << " without candidate; "
-      << vertex_matches << " vertex matches on " << crossings_matched
-      << " crossings; " << faults << " database faults; " << Fixed(seconds, 2)
-      << " s";
-  return out.str();
+  OptionCheck check;
+  OPTION_GT(check, max_drift_m, 0.0);
+  OPTION_GE(check, sd_gate_factor, 0.0);
+  OPTION_GE(check, max_cross_track_m, 0.0);
+  OPTION_GT(check, max_heading_error_rad, 0.0);
+  OPTION_REQUIRE(check, max_heading_error_rad < 0.5, max_heading_error_rad,
+                 "must be < 0.5 (bands would pair with crossings of other "
+                 "roads)");
+  OPTION_GT(check, min_band_length_m, 0.0);
+  OPTION_LT(check, min_band_length_m, max_band_length_m);
+  OPTION_GT(check, min_band_width_m, 0.0);
+  OPTION_LT(check, min_band_width_m, max_band_width_m);
+  OPTION_GT(check, max_length_difference_m, 0.0);
+  OPTION_GT(check, max_width_difference_m, 0.0);
+  OPTION_GT(check, hit_tolerance_m, 0.0);
+  OPTION_REQUIRE(check, hit_tolerance_m < 0.5, hit_tolerance_m,
+                 "must be < 0.5 (half the band period, or neighbouring bands "
+                 "would explain each other)");
+  OPTION_GT(check, vertex_tolerance_m, 0.0);
+  OPTION_GE(check, missing_band_weight, 0.0);
+  OPTION_GT(check, max_missing_views, 0);
+  OPTION_GE(check, contradiction_weight, 0.0);
+  OPTION_GE(check, unexplained_band_weight, 0.0);
+  OPTION_GE(check, visibility_margin_px, 0.0);
+  OPTION_GE(check, visibility_safety_px, 0.0);
+  OPTION_GE(check, visibility_range_m, 0.0);
+  OPTION_GE(check, window_s, 0.0);
+  OPTION_GT(check, same_correction_tolerance_m, 0.0);
+  OPTION_GE(check, drift_rate_m_per_s, 0.0);
+  OPTION_GT(check, min_margin, 0.0);
+  OPTION_GE(check, min_strong_margin, 0.0);
+  OPTION_GT(check, probe_range_m, 0.0);
+  OPTION_GE(check, neighbour_window_s, 0.0);
+  OPTION_GT(check, neighbour_tolerance_m, 0.0);
+  OPTION_GE(check, max_drift_rate_m_per_s, 0.0);
+  OPTION_GT(check, max_informative_tolerance_m, 0.0);
+  OPTION_GE(check, resolve_base_m, 0.0);
+  OPTION_GE(check, max_drift_per_metre, 0.0);
+  OPTION_GE(check, max_drift_acceleration_m_per_s2, 0.0);
+  OPTION_GE(check, max_resolve_bound_m, 0.0);
+  OPTION_GE(check, max_exclusion_bound_m, 0.0);
+  OPTION_GT(check, max_sd_ratio, 0.0);
+  OPTION_GT(check, shifted_crossing_threshold_m, 0.0);
+  OPTION_GE(check, min_hit_bands, 1);
+  OPTION_GE(check, min_views_for_fault, 1);
+  return check.problem();
 }
 
 Eigen::Vector3d CorrectedEnu(const Pose& measured,
@@ -195,7 +130,8 @@ Eigen::Vector3d CorrectedEnu(const Pose& measured,
 }
 
 MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
-                       const std::function<void(int, int)>& progress) {
+                       const std::function<void(int, int)>& progress,
+                       const CancellationToken& cancel) {
   MatchResult result;
   const std::string problem = options.Check();
   if (!problem.empty()) {
@@ -206,7 +142,7 @@ MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
     result.summary.message = "MatchInput: no road-mark index";
     return result;
   }
-  result = RunSteps(input, options, progress);
+  result = RunSteps(input, options, progress, cancel);
   LOG(INFO) << result.summary.BriefReport();
   return result;
 }

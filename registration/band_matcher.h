@@ -61,7 +61,9 @@
 
 #include "registration/paint_probe.h"
 #include "registration/roadmark_index.h"
+#include "survey/cancellation.h"
 #include "survey/results.h"
+#include "survey/results_match.h"
 #include "survey/rig.h"
 #include "survey/trajectory.h"
 
@@ -212,14 +214,49 @@ struct MatchOptions {
 
   // "" or the first invalid field, e.g. "max_drift_m = -1: must be > 0".
   std::string Check() const;
-};
-
-// A horizontal correction of the measured pose at one exposure (see the
-// header comment): p_true = Rz(heading_rad) (p - p_vehicle) + p_vehicle +
-// shift_enu_m.
-struct PoseCorrection {
-  double heading_rad = 0.0;
-  Eigen::Vector2d shift_enu_m = Eigen::Vector2d::Zero();
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_drift_m", max_drift_m);
+    v("sd_gate_factor", sd_gate_factor);
+    v("max_heading_error_rad", max_heading_error_rad);
+    v("max_cross_track_m", max_cross_track_m);
+    v("min_band_length_m", min_band_length_m);
+    v("max_band_length_m", max_band_length_m);
+    v("min_band_width_m", min_band_width_m);
+    v("max_band_width_m", max_band_width_m);
+    v("max_length_difference_m", max_length_difference_m);
+    v("max_width_difference_m", max_width_difference_m);
+    v("hit_tolerance_m", hit_tolerance_m);
+    v("vertex_tolerance_m", vertex_tolerance_m);
+    v("missing_band_weight", missing_band_weight);
+    v("max_missing_views", max_missing_views);
+    v("contradiction_weight", contradiction_weight);
+    v("unexplained_band_weight", unexplained_band_weight);
+    v("visibility_margin_px", visibility_margin_px);
+    v("visibility_safety_px", visibility_safety_px);
+    v("visibility_range_m", visibility_range_m);
+    v("probe_range_m", probe_range_m);
+    v("window_s", window_s);
+    v("same_correction_tolerance_m", same_correction_tolerance_m);
+    v("drift_rate_m_per_s", drift_rate_m_per_s);
+    v("min_hit_bands", min_hit_bands);
+    v("min_margin", min_margin);
+    v("require_both_ends", require_both_ends);
+    v("min_strong_margin", min_strong_margin);
+    v("neighbour_window_s", neighbour_window_s);
+    v("neighbour_tolerance_m", neighbour_tolerance_m);
+    v("max_drift_rate_m_per_s", max_drift_rate_m_per_s);
+    v("max_informative_tolerance_m", max_informative_tolerance_m);
+    v("resolve_base_m", resolve_base_m);
+    v("max_drift_acceleration_m_per_s2", max_drift_acceleration_m_per_s2);
+    v("max_drift_per_metre", max_drift_per_metre);
+    v("max_resolve_bound_m", max_resolve_bound_m);
+    v("max_exclusion_bound_m", max_exclusion_bound_m);
+    v("max_sd_ratio", max_sd_ratio);
+    v("shifted_crossing_threshold_m", shifted_crossing_threshold_m);
+    v("refuse_shifted_crossings", refuse_shifted_crossings);
+    v("min_views_for_fault", min_views_for_fault);
+  }
 };
 
 // One reconstructed band of an observation.
@@ -268,89 +305,13 @@ struct MatchInput {
       paint_probe;
 };
 
-enum class FaultKind {
-  kCrossingMissingFromDatabase,
-  kCrossingGoneFromStreet,
-  kBandMissingFromStreet,
-  kBandMissingFromDatabase,
-  kCrossingShifted,
-};
-const char* FaultKindName(FaultKind kind);  // e.g. "crossing_gone_from_street"
-
-struct DatabaseFault {
-  FaultKind kind = FaultKind::kCrossingGoneFromStreet;
-  std::string crossing_id;  // empty for a crossing missing from the database
-  int band = 0;             // band faults: the band (or the one beyond)
-  Eigen::Vector2d location_enu = Eigen::Vector2d::Zero();
-  double shift_m = 0.0;  // kCrossingShifted
-  int views = 0;         // exposures behind the finding
-  std::vector<int64_t> exposure_ids;
-  std::string description;
-};
-
-// Why one observation was decided as it was.
-struct ObservationEvidence {
-  int64_t exposure_id = 0;
-  int64_t group_id = 0;
-  double time_s = 0.0;
-  Decision decision = Decision::kNoCandidate;
-  std::string crossing_id;
-  std::string reason;
-  int bands = 0;         // observed bands
-  int usable_bands = 0;  // with a zebra band's shape and 4 vertices
-  int candidate_db_bands = 0;
-  int hypotheses = 0;
-  // Of the chosen (or best) hypothesis, in this observation alone:
-  int hits = 0;
-  int missing = 0;
-  int contradictions = 0;
-  int unexplained = 0;
-  double own_score = 0.0;
-  // Over the window:
-  double aggregated_score = 0.0;
-  bool has_runner_up = false;
-  double runner_up_score = 0.0;
-  double robust_margin = 0.0;     // the margin the decision used
-  double both_ends_margin = 0.0;  // without the stronger end's evidence
-  std::string runner_up;  // what the runner-up is ("band offset +1", ...)
-  bool resolved_by_neighbours = false;
-  PoseCorrection correction;
-  double vertex_rms_m = 0.0;
-  int vertex_matches = 0;
-  std::vector<int> matched_bands;  // database band numbers
-};
-
-struct MatchSummary {
-  int observations = 0;
-  int matched = 0;
-  int refused = 0;
-  int no_candidate = 0;
-  int ambiguous = 0;               // refused as ambiguous
-  int inconsistent = 0;            // refused by the continuity check
-  int resolved_by_neighbours = 0;  // matched thanks to continuity
-  int vertex_matches = 0;
-  int crossings_matched = 0;
-  int faults = 0;
-  double seconds = 0.0;
-  // Empty when the matcher ran; otherwise why not (bad options, no index).
-  std::string message;
-
-  bool IsUsable() const { return message.empty(); }
-  std::string BriefReport() const;
-};
-
-struct MatchResult {
-  std::vector<VertexMatch> matches;
-  std::vector<CrossingDecision> decisions;    // one per observation, in order
-  std::vector<ObservationEvidence> evidence;  // one per observation, in order
-  std::vector<DatabaseFault> faults;
-  MatchSummary summary;
-};
-
 // Matches every observation. Deterministic. `progress` (may be empty) is
 // called with (done, total) observations.
+// Throws CancelledError when `cancel` is cancelled (checked between
+// observations).
 MatchResult MatchBands(const MatchInput& input, const MatchOptions& options,
-                       const std::function<void(int, int)>& progress = {});
+                       const std::function<void(int, int)>& progress = {},
+                       const CancellationToken& cancel = {});
 
 // The ENU position of a body-frame point under a measured pose corrected by
 // `correction` (horizontal only).

@@ -260,9 +260,10 @@ void AcceptResolved(int o, int pick, const Prediction& prediction,
                        : "";
   ev.reason = "resolved by trajectory continuity: the correction " +
               std::string(interpolated ? "interpolated" : "extrapolated") +
-              " from matched exposures (" + Fixed(gap, 1) +
-              " s away; error bound " + Fixed(bound, 2) + " m) " + how +
-              " at " + Fixed(pick_distance, 2) + " m; alone it was " + was;
+              " from matched exposures (" + FormatFixed(gap, 1) +
+              " s away; error bound " + FormatFixed(bound, 2) + " m) " + how +
+              " at " + FormatFixed(pick_distance, 2) + " m; alone it was " +
+              was;
 }
 
 // True when the prediction, too loose to single out one hypothesis, still
@@ -399,8 +400,9 @@ void CheckContinuity(MatchState* state) {
         }
         ++named;
         why << " " << index.crossings()[passes[q].crossing].crossing_id << " ("
-            << Fixed(passes[q].t0 - pass.t0, 1) << " s) implies a "
-            << "correction " << Fixed((passes[q].shift - pass.shift).norm(), 2)
+            << FormatFixed(passes[q].t0 - pass.t0, 1) << " s) implies a "
+            << "correction "
+            << FormatFixed((passes[q].shift - pass.shift).norm(), 2)
             << " m away";
       }
       for (int o : pass.obs) {
@@ -458,12 +460,13 @@ void DetectShiftedCrossings(MatchState* state) {
     for (int o : pass.obs) {
       fault.exposure_ids.push_back(input.observations[o].exposure_id);
     }
-    fault.description =
-        "crossing " + crossing.crossing_id + " implies a correction " +
-        Fixed(deviation, 2) + " m away from the one interpolated between " +
-        index.crossings()[before->crossing].crossing_id + " and " +
-        index.crossings()[after->crossing].crossing_id +
-        ": database crossing shifted (repainted?)";
+    fault.description = "crossing " + crossing.crossing_id +
+                        " implies a correction " + FormatFixed(deviation, 2) +
+                        " m away from the one interpolated between " +
+                        index.crossings()[before->crossing].crossing_id +
+                        " and " +
+                        index.crossings()[after->crossing].crossing_id +
+                        ": database crossing shifted (repainted?)";
     state->faults.push_back(fault);
     for (int o : pass.obs) {
       if (options.refuse_shifted_crossings) {

@@ -78,7 +78,8 @@ bool ExplainNoCandidate(const MatchState& state, int o,
     ev->reason =
         state.candidate_bands[o] == 0
             ? "no database band within the " +
-                  Fixed(Gate(state.options, obs), 1) + " m drift gate: " + what
+                  FormatFixed(Gate(state.options, obs), 1) +
+                  " m drift gate: " + what
             : std::to_string(state.candidate_bands[o]) +
                   " database bands within the drift gate but none fits the "
                   "observed bands' shape: " +
@@ -175,10 +176,11 @@ std::string MatchedReason(const MatchOptions& options,
                           double both_ends) {
   std::ostringstream reason;
   reason << ev.hits << " bands fit crossing " << ev.crossing_id << "; score "
-         << Fixed(ev.aggregated_score, 1) << " over +-"
-         << Fixed(options.window_s, 0) << " s";
+         << FormatFixed(ev.aggregated_score, 1) << " over +-"
+         << FormatFixed(options.window_s, 0) << " s";
   if (runner >= 0) {
-    reason << "; next " << ev.runner_up << " " << Fixed(ev.runner_up_score, 1);
+    reason << "; next " << ev.runner_up << " "
+           << FormatFixed(ev.runner_up_score, 1);
     if (both_ends < options.min_margin) {
       // Said plainly: decided at one end, by what a database fault there
       // cannot fake (bare road where the alternative puts paint, a band
@@ -243,10 +245,10 @@ void DecideAlone(int o, MatchState* state) {
   if (robust_margin < options.min_margin) {
     state->ambiguous[o] = true;
     ev.reason = "ambiguous: " + ev.runner_up + " scores " +
-                Fixed(ev.runner_up_score, 2) + " against " +
-                Fixed(ev.aggregated_score, 2) + " (margin " +
-                Fixed(robust_margin, 2) + " < " + Fixed(options.min_margin, 1) +
-                ")";
+                FormatFixed(ev.runner_up_score, 2) + " against " +
+                FormatFixed(ev.aggregated_score, 2) + " (margin " +
+                FormatFixed(robust_margin, 2) + " < " +
+                FormatFixed(options.min_margin, 1) + ")";
     if (h.main_crossing >= 0) {
       const IndexedCrossing& crossing = index.crossings()[h.main_crossing];
       bool end_seen = false;
@@ -267,8 +269,8 @@ void DecideAlone(int o, MatchState* state) {
                 " by band counts alone (evidence a database missing an "
                 "end band, or an end band hidden in the images, cannot "
                 "fake: " +
-                Fixed(std::max(0.0, one_end_strong), 2) + " < " +
-                Fixed(options.min_strong_margin, 1) + ")";
+                FormatFixed(std::max(0.0, one_end_strong), 2) + " < " +
+                FormatFixed(options.min_strong_margin, 1) + ")";
     return;
   }
   state->accepted[o] = true;
@@ -294,8 +296,8 @@ std::string DescribeAlternative(const RoadmarkIndex& index, const Obs& obs,
   const double bands =
       crossing.spacing_m > 0.0 ? across / crossing.spacing_m : 0.0;
   std::ostringstream out;
-  out << "band offset " << (bands >= 0 ? "+" : "") << Fixed(bands, 1) << " ("
-      << Fixed(delta.norm(), 2) << " m)";
+  out << "band offset " << (bands >= 0 ? "+" : "") << FormatFixed(bands, 1)
+      << " (" << FormatFixed(delta.norm(), 2) << " m)";
   return out.str();
 }
 

@@ -32,6 +32,7 @@
 
 #include "registration/band_matcher.h"
 #include "registration/roadmark_index.h"
+#include "survey/csv.h"
 
 namespace zebrageo {
 namespace band_matcher_internal {
@@ -53,14 +54,6 @@ inline Eigen::Matrix2d Rotation2(double angle) {
   Eigen::Matrix2d r;
   r << c, -s, s, c;
   return r;
-}
-
-inline std::string Fixed(double value, int decimals) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(decimals);
-  out << value;
-  return out.str();
 }
 
 // Corner k of an observed band goes to database corner Corner(perm, k):

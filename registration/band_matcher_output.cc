@@ -218,7 +218,8 @@ void DetectCrossingsMissingFromDatabase(MatchState* state) {
     fault.exposure_ids = cluster.exposures;
     fault.description =
         "a crossing seen in " + std::to_string(fault.views) + " views near E " +
-        Fixed(cluster.centre.x(), 1) + " N " + Fixed(cluster.centre.y(), 1) +
+        FormatFixed(cluster.centre.x(), 1) + " N " +
+        FormatFixed(cluster.centre.y(), 1) +
         " (measured trajectory) has no database crossing within the drift "
         "gate: missing from the database";
     state->faults.push_back(fault);
@@ -317,7 +318,8 @@ bool RefuseUnrefined(int o, MatchState* state) {
   ev.decision = Decision::kRefused;
   ev.reason = "after refinement only " + std::to_string(bands.size()) +
               " band(s) fit to vertex_tolerance_m = " +
-              Fixed(options.vertex_tolerance_m, 2) + " m; was: " + ev.reason;
+              FormatFixed(options.vertex_tolerance_m, 2) +
+              " m; was: " + ev.reason;
   return true;
 }
 

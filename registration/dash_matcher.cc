@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -25,19 +27,12 @@ bool NamesDash(const std::string& type) {
 }  // namespace
 
 std::string DashMatchOptions::Check() const {
-  std::ostringstream e;
-  if (!(max_dash_length_m > 0.0)) {
-    e << "max_dash_length_m = " << max_dash_length_m << ": must be positive";
-  } else if (!(min_length_difference_m < max_length_difference_m)) {
-    e << "min_length_difference_m = " << min_length_difference_m
-      << ": must be below max_length_difference_m";
-  } else if (!(max_across_m > 0.0)) {
-    e << "max_across_m = " << max_across_m << ": must be positive";
-  } else if (!(min_separation_ratio >= 1.0)) {
-    e << "min_separation_ratio = " << min_separation_ratio
-      << ": must be at least 1";
-  }
-  return e.str();
+  OptionCheck check;
+  OPTION_GT(check, max_dash_length_m, 0.0);
+  OPTION_LT(check, min_length_difference_m, max_length_difference_m);
+  OPTION_GT(check, max_across_m, 0.0);
+  OPTION_GE(check, min_separation_ratio, 1.0);
+  return check.problem();
 }
 
 std::vector<int> DatabaseDashes(const std::vector<DatabaseLineEnu>& database,

@@ -52,6 +52,14 @@ struct DashMatchOptions {
   double min_separation_ratio = 2.5;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_dash_length_m", max_dash_length_m);
+    v("min_length_difference_m", min_length_difference_m);
+    v("max_length_difference_m", max_length_difference_m);
+    v("max_across_m", max_across_m);
+    v("min_separation_ratio", min_separation_ratio);
+  }
 };
 
 // One reconstructed dash in ENU: its two end points (the first and last

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -56,18 +57,13 @@ DatabaseCrossingEdge EdgeThrough(const std::string& crossing_id,
 }  // namespace
 
 std::string CrossingEdgeMatchOptions::Check() const {
-  std::ostringstream e;
-  if (!(gate_m > 0.0)) {
-    e << "gate_m must be positive";
-  } else if (!(min_separation_ratio >= 1.0)) {
-    e << "min_separation_ratio must be at least 1";
-  } else if (!(max_angle_rad > 0.0 && max_angle_rad < 1.0)) {
-    e << "max_angle_rad must be in (0, 1)";
-  } else if (!(max_spread_m > 0.0) || !(extent_margin_m >= 0.0)) {
-    e << "max_spread_m must be positive and extent_margin_m not negative";
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "edge match options: " + error;
+  OptionCheck check;
+  OPTION_GT(check, gate_m, 0.0);
+  OPTION_GE(check, min_separation_ratio, 1.0);
+  OPTION_IN(check, max_angle_rad, "(", 0.0, 1.0, ")");
+  OPTION_GT(check, max_spread_m, 0.0);
+  OPTION_GE(check, extent_margin_m, 0.0);
+  return check.problem();
 }
 
 std::vector<DatabaseCrossingEdge> DatabaseCrossingEdges(

@@ -38,6 +38,14 @@ struct CrossingEdgeMatchOptions {
   double extent_margin_m = 0.6;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("gate_m", gate_m);
+    v("min_separation_ratio", min_separation_ratio);
+    v("max_angle_rad", max_angle_rad);
+    v("max_spread_m", max_spread_m);
+    v("extent_margin_m", extent_margin_m);
+  }
 };
 
 // One edge of a database crossing: the mid-points of its bands' ends on one

@@ -14,6 +14,7 @@
 
 #include "registration/line_geometry_internal.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 
@@ -23,18 +24,13 @@ using line_geometry_internal::SegmentDistance2d;
 using line_geometry_internal::SegmentGrid;
 
 std::string LineMatchOptions::Check() const {
-  std::ostringstream e;
-  if (!(gate_m > 0.0) || !(max_height_m > 0.0)) {
-    e << "gate_m and max_height_m must be positive";
-  } else if (!(min_separation_ratio >= 1.0)) {
-    e << "min_separation_ratio must be at least 1";
-  } else if (!(max_angle_rad > 0.0 && max_angle_rad < M_PI / 2)) {
-    e << "max_angle_rad must be in (0, pi/2)";
-  } else if (!(min_matched_share > 0.0 && min_matched_share <= 1.0)) {
-    e << "min_matched_share must be in (0, 1]";
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "line matching options: " + error;
+  OptionCheck check;
+  OPTION_GT(check, gate_m, 0.0);
+  OPTION_GT(check, max_height_m, 0.0);
+  OPTION_GE(check, min_separation_ratio, 1.0);
+  OPTION_IN(check, max_angle_rad, "(", 0.0, kPi / 2.0, ")");
+  OPTION_IN(check, min_matched_share, "(", 0.0, 1.0, "]");
+  return check.problem();
 }
 
 double DatabaseLineGrade(const DatabaseLineEnu& line, int segment, double t,
@@ -173,16 +169,12 @@ std::vector<LinePointMatch> MatchLinePoints(
 }
 
 std::string LineConsistencyOptions::Check() const {
-  std::ostringstream e;
-  if (!(window_s > 0.0) || !(max_offset_m > 0.0)) {
-    e << "window_s and max_offset_m must be positive";
-  } else if (min_points < 1) {
-    e << "min_points must be at least 1";
-  } else if (!(min_parallel_cos > 0.0 && min_parallel_cos < 1.0)) {
-    e << "min_parallel_cos must be in (0, 1)";
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "line consistency options: " + error;
+  OptionCheck check;
+  OPTION_GT(check, window_s, 0.0);
+  OPTION_GT(check, max_offset_m, 0.0);
+  OPTION_GE(check, min_points, 1);
+  OPTION_IN(check, min_parallel_cos, "(", 0.0, 1.0, ")");
+  return check.problem();
 }
 
 namespace {

@@ -42,6 +42,14 @@ struct LineMatchOptions {
   double min_matched_share = 0.5;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("gate_m", gate_m);
+    v("max_height_m", max_height_m);
+    v("min_separation_ratio", min_separation_ratio);
+    v("max_angle_rad", max_angle_rad);
+    v("min_matched_share", min_matched_share);
+  }
 };
 
 // A database line in the working frame.
@@ -110,6 +118,13 @@ struct LineConsistencyOptions {
   double min_parallel_cos = 0.9;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("window_s", window_s);
+    v("max_offset_m", max_offset_m);
+    v("min_points", min_points);
+    v("min_parallel_cos", min_parallel_cos);
+  }
 };
 
 struct RejectedLine {

@@ -10,6 +10,7 @@
 
 #include "registration/line_geometry_internal.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 
@@ -190,23 +191,21 @@ void DecideByContinuity(const std::vector<std::vector<Vote>>& votes,
 }  // namespace
 
 std::string LateralOffsetOptions::Check() const {
-  std::ostringstream e;
-  if (!(max_offset_m > 0.0) || !(window_s > 0.0) || !(bin_m > 0.0) ||
-      !(tolerance_m > 0.0) || !(min_separation_m > 0.0) ||
-      !(min_spread_m >= 0.0)) {
-    e << "max_offset_m, window_s, bin_m, tolerance_m and min_separation_m "
-         "must be positive, min_spread_m not negative";
-  } else if (continuity_windows < 0 || !(continuity_m >= 0.0) ||
-             !(min_continuity_points >= 1.0)) {
-    e << "continuity_windows and continuity_m must not be negative, "
-         "min_continuity_points at least 1";
-  } else if (!(min_ratio >= 1.0) || min_points < 1) {
-    e << "min_ratio must be at least 1 and min_points at least 1";
-  } else if (max_offset_m / bin_m > 1e5) {
-    e << "max_offset_m / bin_m must be at most 1e5";
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "lateral offset options: " + error;
+  OptionCheck check;
+  OPTION_GT(check, max_offset_m, 0.0);
+  OPTION_GT(check, window_s, 0.0);
+  OPTION_GT(check, bin_m, 0.0);
+  OPTION_GT(check, tolerance_m, 0.0);
+  OPTION_GT(check, min_separation_m, 0.0);
+  OPTION_GE(check, min_spread_m, 0.0);
+  OPTION_GE(check, continuity_windows, 0);
+  OPTION_GE(check, continuity_m, 0.0);
+  OPTION_GE(check, min_continuity_points, 1.0);
+  OPTION_GE(check, min_ratio, 1.0);
+  OPTION_GE(check, min_points, 1);
+  OPTION_REQUIRE(check, max_offset_m / bin_m <= 1e5, max_offset_m,
+                 "must be at most 1e5 bins (bin_m)");
+  return check.problem();
 }
 
 std::vector<LateralOffset> SearchLateralOffsets(

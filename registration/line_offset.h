@@ -52,6 +52,20 @@ struct LateralOffsetOptions {
   double min_continuity_points = 5.0;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_offset_m", max_offset_m);
+    v("window_s", window_s);
+    v("bin_m", bin_m);
+    v("tolerance_m", tolerance_m);
+    v("min_separation_m", min_separation_m);
+    v("min_ratio", min_ratio);
+    v("min_points", min_points);
+    v("min_spread_m", min_spread_m);
+    v("continuity_windows", continuity_windows);
+    v("continuity_m", continuity_m);
+    v("min_continuity_points", min_continuity_points);
+  }
 };
 
 struct LateralOffset {

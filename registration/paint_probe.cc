@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "survey/image_io.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -59,24 +60,16 @@ const char* PaintEvidenceName(PaintEvidence evidence) {
 }
 
 std::string PaintProbeOptions::Check() const {
-  std::ostringstream e;
-  if (!(sample_share > 0.0 && sample_share <= 1.0)) {
-    e << "sample_share = " << sample_share << ": must be in (0, 1]";
-  } else if (!(min_contrast > 0.0)) {
-    e << "min_contrast = " << min_contrast << ": must be positive";
-  } else if (!(bare_level >= 0.0 && bare_level < paint_level &&
-               paint_level <= 1.0)) {
-    e << "bare_level, paint_level = " << bare_level << ", " << paint_level
-      << ": need 0 <= bare_level < paint_level <= 1";
-  } else if (!(max_bare_spread > 0.0)) {
-    e << "max_bare_spread = " << max_bare_spread << ": must be positive";
-  } else if (!(min_inside_share > 0.0 && min_inside_share <= 1.0)) {
-    e << "min_inside_share = " << min_inside_share << ": must be in (0, 1]";
-  } else if (cached_images < 1) {
-    e << "cached_images = " << cached_images << ": must be at least 1";
-  }
-  const std::string error = e.str();
-  return error.empty() ? error : "paint probe options: " + error;
+  OptionCheck check;
+  OPTION_IN(check, sample_share, "(", 0.0, 1.0, "]");
+  OPTION_GT(check, min_contrast, 0.0);
+  OPTION_GE(check, bare_level, 0.0);
+  OPTION_GT(check, paint_level, bare_level);
+  OPTION_LE(check, paint_level, 1.0);
+  OPTION_GT(check, max_bare_spread, 0.0);
+  OPTION_IN(check, min_inside_share, "(", 0.0, 1.0, "]");
+  OPTION_GE(check, cached_images, 1);
+  return check.problem();
 }
 
 ImagePaintProbe::ImagePaintProbe(const Survey& survey,

@@ -63,6 +63,16 @@ struct PaintProbeOptions {
   int cached_images = 16;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("sample_share", sample_share);
+    v("min_contrast", min_contrast);
+    v("paint_level", paint_level);
+    v("bare_level", bare_level);
+    v("max_bare_spread", max_bare_spread);
+    v("min_inside_share", min_inside_share);
+    v("cached_images", cached_images);
+  }
 };
 
 class ImagePaintProbe {

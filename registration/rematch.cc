@@ -1,77 +1,37 @@
-// The second registration pass of `zebrageo run` (match_stage.h): the
-// observations the first pass left undecided, matched again on the
-// trajectory the adjustment corrected.
+#include "registration/rematch.h"
+
 #include <glog/logging.h>
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <map>
-#include <optional>
 #include <set>
 #include <sstream>
 #include <tuple>
 #include <utility>
 
-#include "registration/match_stage.h"
+#include "registration/observations.h"
 #include "registration/paint_probe.h"
-#include "survey/input_error.h"
-#include "survey/results_adjustment.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 
-namespace fs = std::filesystem;
-
 std::string RematchOptions::Check() const {
-  if (min_control_crossings < 1) {
-    return "min_control_crossings = " + std::to_string(min_control_crossings) +
-           ": must be >= 1";
-  }
-  if (min_hit_bands < 1) {
-    return "min_hit_bands = " + std::to_string(min_hit_bands) +
-           ": must be >= 1";
-  }
-  if (!(gate_m > 0.0) || !std::isfinite(gate_m)) {
-    return "gate_m = " + std::to_string(gate_m) + ": must be finite and > 0";
-  }
-  if (!(cross_track_gate_m > 0.0) || !(cross_track_gate_m < 0.5)) {
-    // Half a band period: beyond it a wrong band offset can be nearer.
-    return "cross_track_gate_m = " + std::to_string(cross_track_gate_m) +
-           ": must be in (0, 0.5)";
-  }
-  if (!(max_line_control_gap_m >= 0.0) ||
-      !std::isfinite(max_line_control_gap_m)) {
-    return "max_line_control_gap_m = " +
-           std::to_string(max_line_control_gap_m) + ": must be finite and >= 0";
-  }
-  if (!(max_cross_track_control_gap_m >= 0.0) ||
-      !std::isfinite(max_cross_track_control_gap_m)) {
-    return "max_cross_track_control_gap_m = " +
-           std::to_string(max_cross_track_control_gap_m) +
-           ": must be finite and >= 0";
-  }
-  if (!(max_sideways_m >= 0.0) || !(max_sideways_m < 0.5)) {
-    return "max_sideways_m = " + std::to_string(max_sideways_m) +
-           ": must be in [0, 0.5)";
-  }
-  if (!(max_line_drift_sd_m >= 0.0) || !std::isfinite(max_line_drift_sd_m)) {
-    return "max_line_drift_sd_m = " + std::to_string(max_line_drift_sd_m) +
-           ": must be finite and >= 0";
-  }
-  if (!(max_line_bracket_gap_s >= 0.0)) {
-    return "max_line_bracket_gap_s = " +
-           std::to_string(max_line_bracket_gap_s) + ": must be >= 0";
-  }
-  if (!(sd_gate_factor > 0.0) || !std::isfinite(sd_gate_factor)) {
-    return "sd_gate_factor = " + std::to_string(sd_gate_factor) +
-           ": must be finite and > 0";
-  }
-  if (!(max_heading_error_rad > 0.0) || !(max_heading_error_rad < 0.5)) {
-    return "max_heading_error_rad = " + std::to_string(max_heading_error_rad) +
-           ": must be in (0, 0.5)";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GE(check, min_control_crossings, 1);
+  OPTION_GE(check, min_hit_bands, 1);
+  OPTION_GT(check, gate_m, 0.0);
+  // Half a band period: beyond it a wrong band offset can be nearer.
+  OPTION_IN(check, cross_track_gate_m, "(", 0.0, 0.5, ")");
+  OPTION_GE(check, max_line_control_gap_m, 0.0);
+  OPTION_GE(check, max_cross_track_control_gap_m, 0.0);
+  OPTION_IN(check, max_sideways_m, "[", 0.0, 0.5, ")");
+  OPTION_GE(check, max_line_drift_sd_m, 0.0);
+  OPTION_GE(check, max_line_bracket_gap_s, 0.0);
+  OPTION_GT(check, sd_gate_factor, 0.0);
+  OPTION_IN(check, max_heading_error_rad, "(", 0.0, 0.5, ")");
+  return check.problem();
 }
 
 namespace {
@@ -359,7 +319,7 @@ MatchResult MatchOnAdjustedTrajectory(
       (*bands_of)[{o.exposure_id, o.group_id}].insert(b.band_id);
     }
   }
-  return MatchBands(input, tight);
+  return MatchBands(input, tight, {}, first.cancel);
 }
 
 // Vertex matches of the first pass that the second makes differently, and
@@ -553,100 +513,6 @@ std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
     if (row.constrains_across) ids.push_back(row.exposure_id);
   }
   return SortedExposureTimes(ids, exposures, {});
-}
-
-std::vector<double> LineControlTimesIn(const std::string& results_folder,
-                                       const ExposureTable& exposures) {
-  const fs::path path = fs::path(results_folder) / kLineMatchesFile;
-  if (!fs::exists(path)) return {};
-  return LineControlTimes(ReadLineMatches(path.string(), kLineMatchesFile),
-                          exposures);
-}
-
-std::set<std::string> RejectedCrossingsIn(const std::string& results_folder) {
-  const fs::path path = fs::path(results_folder) / kGcpResidualsFile;
-  std::set<std::string> crossings;
-  if (!fs::exists(path)) return crossings;
-  for (const GcpResidual& r :
-       ReadGcpResiduals(path.string(), kGcpResidualsFile)) {
-    if (r.status == GcpStatus::kRejected) crossings.insert(r.crossing_id);
-  }
-  return crossings;
-}
-
-void WriteRematchResults(const RematchSummary& summary,
-                         const std::string& results_folder) {
-  if (summary.added == 0 && summary.dropped == 0) return;
-  const std::vector<std::string> comments = {"zebrageo run: " +
-                                             summary.message};
-  const fs::path folder(results_folder);
-  WriteMatches(summary.matches, comments, (folder / kMatchesFile).string());
-  WriteCrossingDecisions(summary.decisions, comments,
-                         (folder / kCrossingDecisionsFile).string());
-}
-
-RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
-                                             const std::string& results_folder,
-                                             const MatchOptions& options,
-                                             const RematchOptions& rematch) {
-  const fs::path folder(results_folder);
-  // adjustment.json first: without it (or unreadable) nothing else is read.
-  std::optional<AdjustmentRecord> record;
-  const fs::path record_path = folder / kAdjustmentJsonFile;
-  if (fs::exists(record_path)) {
-    try {
-      record = ReadAdjustmentRecord(record_path.string(), kAdjustmentJsonFile);
-    } catch (const InputError&) {
-      RematchSummary summary;
-      summary.message = std::string("second registration pass skipped: ") +
-                        kAdjustmentJsonFile + " is not readable JSON";
-      return summary;
-    }
-  }
-  RematchInput first;
-  first.adjustment = record ? &*record : nullptr;
-  if (!AdjustmentUnfitForRematch(first.adjustment, false,
-                                 rematch.min_control_crossings)
-           .empty()) {
-    return RematchWithAdjustedTrajectory(survey, first, options, rematch);
-  }
-  const std::vector<CrossingDecision> decisions = ReadCrossingDecisions(
-      (folder / kCrossingDecisionsFile).string(), kCrossingDecisionsFile);
-  const std::vector<VertexMatch> matches =
-      ReadMatches((folder / kMatchesFile).string(), kMatchesFile);
-  first.decisions = &decisions;
-  first.matches = &matches;
-  // The corrected trajectory and the bands only when something is left
-  // undecided (RematchWithAdjustedTrajectory returns before using them).
-  std::vector<TrajectorySample> adjusted;
-  std::vector<ReconstructedVertex> vertices;
-  const bool undecided = std::any_of(decisions.begin(), decisions.end(),
-                                     [](const CrossingDecision& d) {
-                                       return d.decision != Decision::kMatched;
-                                     });
-  if (undecided) {
-    adjusted = ReadTrajectorySamples(
-        (folder / kTrajectoryCorrectedFile).string(), kTrajectoryCorrectedFile);
-    vertices = ReadReconstructedBands(
-        (folder / kReconstructedBandsFile).string(), kReconstructedBandsFile);
-  }
-  first.adjusted_trajectory = &adjusted;
-  first.vertices = &vertices;
-  // Where road lines held the cross-track position: after them alone the
-  // pass searches only there; after crossings and lines, no farther from
-  // them and the crossings than max_cross_track_control_gap_m. A stale
-  // line_matches.csv can only narrow the search.
-  std::vector<double> line_times;
-  if (undecided) {
-    line_times = LineControlTimesIn(results_folder, survey.exposures);
-  }
-  first.line_control_times = &line_times;
-  const std::set<std::string> rejected = RejectedCrossingsIn(results_folder);
-  first.rejected_crossings = &rejected;
-  const RematchSummary summary =
-      RematchWithAdjustedTrajectory(survey, first, options, rematch);
-  WriteRematchResults(summary, results_folder);
-  return summary;
 }
 
 }  // namespace zebrageo

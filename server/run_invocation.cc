@@ -5,6 +5,8 @@
 #include <regex>
 #include <sstream>
 
+#include "pipeline/exit_codes.h"
+#include "pipeline/run_options.h"
 #include "survey/atomic_file.h"
 
 namespace zebrageo {
@@ -26,16 +28,17 @@ const std::vector<std::string> kStages = {"reconstruct", "match", "adjust"};
 
 std::string RunOptionsProblem(const json& options) {
   if (!options.is_object()) return "options: must be a JSON object";
-  // `zebrageo run --options FILE` (issue 44) is not in this version yet:
-  // only the defaults can be run.
-  if (!options.empty()) {
-    return "options: this zebrageo runs with the default options only "
-           "(`zebrageo run --options` is not built yet)";
+  // The check of `zebrageo run --options FILE`: unknown members, wrong
+  // types and refused values are named by their path.
+  try {
+    RunOptionsFromJson(options);
+  } catch (const UsageError& error) {
+    return std::string("options: ") + error.what();
   }
   return "";
 }
 
-json DefaultRunOptions() { return json::object(); }
+json DefaultRunOptions() { return RunOptionsToJson(RunOptions()); }
 
 std::vector<std::string> RunArguments(const std::string& survey,
                                       const JobFiles& files,
@@ -74,7 +77,7 @@ RunProgress ReadRunProgress(const JobFiles& files) {
   if (complete == static_cast<int>(kStages.size())) progress.stage = "report";
   double within = 0.0;
   // Within a stage: the run's last progress line in the log, "I... ] step:
-  // done/total (NN%), S s" (tools/progress.cc, every 10 % when stderr is
+  // done/total (NN%), S s" (tools/progress_bars.cc, every 10 % when stderr is
   // not a terminal). The lines of the stage's own name advance the
   // fraction (the largest: a stage never goes back); the last line names
   // the step (the tie points inside adjust).

@@ -15,10 +15,10 @@
 #include <regex>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/version.h"
 #include "server/api_internal.h"
 #include "server/child_process.h"
 #include "server/run_invocation.h"
-#include "tools/version.h"
 
 namespace zebrageo {
 namespace {

@@ -7,8 +7,8 @@
 #include <ctime>
 #include <sstream>
 
+#include "pipeline/version.h"
 #include "server/api_internal.h"
-#include "tools/version.h"
 
 namespace zebrageo {
 namespace {

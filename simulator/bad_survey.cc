@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "survey/atomic_file.h"
+#include "survey/text_file.h"
 
 namespace zebrageo {
 namespace {
@@ -19,11 +20,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path.string());
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return ReadTextFile(path.string(), path.string());
 }
 
 void WriteText(const fs::path& path, const std::string& text) {

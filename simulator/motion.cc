@@ -15,7 +15,6 @@
 namespace zebrageo::sim {
 namespace {
 
-constexpr double kDegToRad = kPi / 180.0;
 // Half the distance between the wheels, for the roll on the camber.
 constexpr double kHalfTrackM = 0.8;
 
@@ -189,13 +188,13 @@ class Suspension {
     for (double& p : phase_) p = Uniform(&susp_rng, 0.0, 2.0 * kPi);
   }
   double Roll(double t) const {
-    return roll_deg_ * kDegToRad *
+    return DegToRad(roll_deg_) *
            (std::sin(2 * kPi * f_ * t + phase_[0]) +
             0.4 * std::sin(2 * kPi * 1.63 * f_ * t + phase_[1])) /
            1.4;
   }
   double Pitch(double t) const {
-    return pitch_deg_ * kDegToRad *
+    return DegToRad(pitch_deg_) *
            (std::sin(2 * kPi * 0.83 * f_ * t + phase_[2]) +
             0.4 * std::sin(2 * kPi * 1.37 * f_ * t + phase_[3])) /
            1.4;
@@ -230,11 +229,10 @@ InsDrift DrawInsDrift(const SimulationOptions& options,
   Drift along(options.drift_along_track_m, bias, period, &drift_rng);
   Drift across(options.drift_cross_track_m, bias, period, &drift_rng);
   Drift vertical(options.drift_vertical_m, bias, period, &drift_rng);
-  Drift heading_error(options.heading_drift_deg * kDegToRad, 0.3, period,
+  Drift heading_error(DegToRad(options.heading_drift_deg), 0.3, period,
                       &drift_rng);
-  Drift roll_error(options.tilt_drift_deg * kDegToRad, 0.3, period, &drift_rng);
-  Drift pitch_error(options.tilt_drift_deg * kDegToRad, 0.3, period,
-                    &drift_rng);
+  Drift roll_error(DegToRad(options.tilt_drift_deg), 0.3, period, &drift_rng);
+  Drift pitch_error(DegToRad(options.tilt_drift_deg), 0.3, period, &drift_rng);
   for (Drift* d : {&along, &across, &vertical, &heading_error, &roll_error,
                    &pitch_error}) {
     d->Normalise(times);
@@ -399,7 +397,7 @@ void IntegrateInsDrift(const SimulationOptions& options,
     const double t = drive.times[k];
     if (t < outage->begin) continue;
     if (t >= outage->end) break;
-    const double angle = options.outage_heading_drift_deg * kDegToRad *
+    const double angle = DegToRad(options.outage_heading_drift_deg) *
                          (t - outage->begin) / duration;
     const Eigen::Vector2d step = (p_enu[k] - p_enu[k - 1]).head<2>();
     sum += -angle * Eigen::Vector2d(-step.y(), step.x());
@@ -441,7 +439,7 @@ class Jitter {
   Jitter(const SimulationOptions& options, double dt)
       : rng_(SubSeed(options.seed, kJitterSeed)),
         step_m_(options.vehicle_speed_mps * dt *
-                std::tan(options.jitter_direction_deg * kDegToRad)),
+                std::tan(DegToRad(options.jitter_direction_deg))),
         decay_(std::exp(-dt / options.jitter_correlation_s)) {}
   bool active() const { return step_m_ > 0.0; }
   // The offset of the next sample.
@@ -520,12 +518,12 @@ SampleError SampleErrorAt(const SimulationOptions& options, const Road& road,
     if (options.outage_ins_drift) {
       error += outage.ins_error[k];
       sample.extra_heading =
-          options.outage_heading_drift_deg * kDegToRad * sample.outage_fraction;
+          DegToRad(options.outage_heading_drift_deg) * sample.outage_fraction;
     } else {
       error += options.outage_drift_m * sample.outage_fraction *
                sample.outage_fraction * outage.direction;
       sample.extra_heading =
-          options.heading_drift_deg * kDegToRad * sample.outage_fraction;
+          DegToRad(options.heading_drift_deg) * sample.outage_fraction;
     }
   }
   if (outage.active && t >= outage.end) {
@@ -557,7 +555,7 @@ TrajectorySample MeasuredSampleOf(const SimulationOptions& options,
   measured.sd_attitude_rad = Eigen::Vector3d(options.reported_sd_tilt_deg,
                                              options.reported_sd_tilt_deg,
                                              options.reported_sd_heading_deg) *
-                             kDegToRad;
+                             DegToRad(1.0);
   return measured;
 }
 
@@ -654,7 +652,7 @@ VehicleMotion SimulateMotion(const SimulationOptions& options,
 Rig MakeRig(const SimulationOptions& options) {
   std::mt19937_64 rng(SubSeed(options.seed, kRigSeed));
   Rig rig;
-  const double alpha = options.camera_pitch_down_deg * kDegToRad;
+  const double alpha = DegToRad(options.camera_pitch_down_deg);
   // Camera axes in the body (FRD): x_cam = right, z_cam = forward pitched
   // down by alpha, y_cam = z_cam x x_cam (down-ish). Looking backwards, the
   // image's right is the body's left.
@@ -679,7 +677,7 @@ Rig MakeRig(const SimulationOptions& options) {
   for (size_t c = 0; c < mounts.size(); ++c) {
     const Mount& mount = mounts[c];
     const double f = mount.backwards ? -1.0 : 1.0;
-    const double m = options.camera_misalignment_deg * kDegToRad;
+    const double m = DegToRad(options.camera_misalignment_deg);
     const Eigen::Matrix3d misalignment =
         (Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitX()) *
          Eigen::AngleAxisd(Uniform(&rng, -m, m), Eigen::Vector3d::UnitY()) *

@@ -36,8 +36,6 @@
 namespace zebrageo {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / kPi;
-
 std::string Fmt(double v) { return FormatDouble(v); }
 
 double RoundTo(double value, double step) {
@@ -184,7 +182,7 @@ nlohmann::json TrajectoryErrorJson(const SimulationOptions& options,
   error["rms_horizontal_m"] =
       std::sqrt(sum_h2 / std::max<size_t>(1, motion.position_error_enu.size()));
   error["max_vertical_m"] = max_v;
-  error["max_heading_deg"] = max_heading * kRadToDeg;
+  error["max_heading_deg"] = RadToDeg(max_heading);
   error["reported_sd_horizontal_m"] = options.reported_sd_horizontal_m;
   if (motion.outage_end_time > motion.outage_begin_time) {
     error["outage_time"] = {motion.outage_begin_time, motion.outage_end_time};

@@ -30,7 +30,6 @@ using world_internal::Subtract;
 
 namespace {
 
-constexpr double kDegToRad = kPi / 180.0;
 // The centreline starts kLeadIn before the driven part and ends kLookAhead
 // after it, so the cameras see road at the end of the drive.
 constexpr double kLeadInM = 20.0;
@@ -98,7 +97,7 @@ Crossing DesignCrossing(const SimulationOptions& options, const Road& road,
     c.skew_deg = Uniform(rng, lo, options.max_skew_deg) *
                  (Bernoulli(rng, 0.5) ? 1.0 : -1.0);
   }
-  c.tan_skew = std::tan(c.skew_deg * kDegToRad);
+  c.tan_skew = std::tan(DegToRad(c.skew_deg));
   c.band_length_m =
       Uniform(rng, options.min_band_length_m, options.max_band_length_m);
   c.band_width_m = options.band_width_m;
@@ -493,14 +492,14 @@ World BuildWorld(const SimulationOptions& options) {
   spec.min_curve_radius_m = options.min_curve_radius_m;
   spec.max_curve_radius_m = options.max_curve_radius_m;
   spec.transition_length_m = options.transition_length_m;
-  spec.start_heading_rad = 0.5 * kPi - options.start_heading_deg * kDegToRad;
+  spec.start_heading_rad = 0.5 * kPi - DegToRad(options.start_heading_deg);
   World world;
   world.road = Road::Generate(spec, SubSeed(options.seed, kRoadSeed));
   world.s_drive_start = kLeadInM;
   world.s_drive_end = kLeadInM + options.road_length_m;
   world.lane_offset_m = -0.25 * options.road_width_m;
-  const double elevation = options.sun_elevation_deg * kDegToRad;
-  const double azimuth = options.sun_azimuth_deg * kDegToRad;
+  const double elevation = DegToRad(options.sun_elevation_deg);
+  const double azimuth = DegToRad(options.sun_azimuth_deg);
   world.sun_enu = Eigen::Vector3d(std::sin(azimuth) * std::cos(elevation),
                                   std::cos(azimuth) * std::cos(elevation),
                                   std::sin(elevation));

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "survey/math_util.h"
+
 namespace zebrageo {
 namespace {
 
@@ -50,14 +52,13 @@ class TangentPlane {
   explicit TangentPlane(const Geodetic& origin) : origin_(origin) {
     constexpr double kA = 6378137.0;             // WGS84 semi-major axis
     constexpr double kE2 = 6.69437999014132e-3;  // first eccentricity^2
-    constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-    const double s = std::sin(origin.lat_deg * kRadPerDeg);
+    const double s = std::sin(DegToRad(origin.lat_deg));
     const double w2 = 1.0 - kE2 * s * s;
     const double prime_vertical = kA / std::sqrt(w2);
     const double meridian = kA * (1.0 - kE2) / (w2 * std::sqrt(w2));
     east_m_per_deg_ = (prime_vertical + origin.h_m) *
-                      std::cos(origin.lat_deg * kRadPerDeg) * kRadPerDeg;
-    north_m_per_deg_ = (meridian + origin.h_m) * kRadPerDeg;
+                      std::cos(DegToRad(origin.lat_deg)) * DegToRad(1.0);
+    north_m_per_deg_ = (meridian + origin.h_m) * DegToRad(1.0);
   }
 
   Eigen::Vector2d Offset(const Geodetic& p) const {

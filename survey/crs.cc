@@ -7,6 +7,8 @@
 #include <sstream>
 #include <utility>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -217,10 +219,12 @@ std::string JoinGrids(const std::vector<std::string>& grids) {
 }  // namespace
 
 std::string CrsOptions::Check() const {
+  OptionCheck check;
   for (const std::string& folder : grid_dirs) {
-    if (folder.empty()) return "grid_dirs: an empty folder name";
+    check.Require(!folder.empty(), "grid_dirs[]", std::string("\"\""),
+                  "must not be an empty folder name");
   }
-  return "";
+  return check.problem();
 }
 
 Crs::Crs(const std::string& definition) : definition_(definition) {

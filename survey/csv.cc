@@ -173,6 +173,19 @@ std::string FormatDouble(double value) {
   return std::string(buffer, result.ptr);
 }
 
+std::string FormatFixed(double value, int decimals) {
+  char buffer[512];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value,
+                                    std::chars_format::fixed, decimals);
+  return std::string(buffer, result.ptr);
+}
+
+double ParseDouble(const std::string& text) {
+  double value = 0.0;
+  std::from_chars(text.data(), text.data() + text.size(), value);
+  return value;
+}
+
 void CsvWriter::Comment(const std::string& text) {
   *out_ << "# " << text << '\n';
 }
@@ -208,10 +221,7 @@ CsvWriter& CsvWriter::Add(const std::string& value) {
 
 CsvWriter& CsvWriter::AddFixed(double value, int decimals) {
   Separator();
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value,
-                                    std::chars_format::fixed, decimals);
-  *out_ << std::string(buffer, result.ptr);
+  *out_ << FormatFixed(value, decimals);
   return *this;
 }
 

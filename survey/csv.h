@@ -92,6 +92,12 @@ class CsvWriter {
 
 // Shortest decimal text that reads back to exactly `value`.
 std::string FormatDouble(double value);
+// `value` with `decimals` decimals (printf's %.*f): for a person, and the
+// fixed-point columns of the results files.
+std::string FormatFixed(double value, int decimals);
+// The double a decimal text denotes (the CSV reader's parse): 0 for text
+// that is not one.
+double ParseDouble(const std::string& text);
 
 }  // namespace zebrageo
 

@@ -2,7 +2,8 @@
 //
 // The contract's outputs keep their WGS84 and ENU columns, so every reader
 // of SURVEY_FORMAT.md (and ../shared/tools/score_results.py) reads them
-// unchanged; the output CRS is added beside them:
+// unchanged; their writers (survey/results.h, survey/trajectory.h) add the
+// output CRS beside them when given one:
 //   poses.csv, trajectory_corrected.csv  columns crs_x, crs_y, crs_z: the
 //       row's lat, lon, h in the output CRS;
 //   gcp_residuals.csv  crs_x, crs_y, crs_z: the adjusted position of the
@@ -20,20 +21,53 @@
 #ifndef ZEBRAGEO_SURVEY_OUTPUT_CRS_H_
 #define ZEBRAGEO_SURVEY_OUTPUT_CRS_H_
 
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
+#include <vector>
 
-#include "survey/survey.h"
+#include "survey/crs.h"
+#include "survey/csv.h"
+#include "survey/geodesy.h"
 
 namespace zebrageo {
 
-// Adds the output CRS to each of the files above present in
-// `results_folder`, rewriting them atomically; does nothing when the
-// survey has no output_crs. Idempotent: columns and comments of an earlier
-// call are replaced. Returns the number of files rewritten. Throws
-// InputError naming survey.yaml's output_crs line (unknown CRS, missing
-// grid, a point PROJ cannot convert) or the output file and line (a
-// control point that is not in the survey's database).
-int AddOutputCrs(const Survey& survey, const std::string& results_folder);
+struct Survey;
+
+class OutputCrs {
+ public:
+  // Null when the survey has no output_crs. Throws InputError naming
+  // survey.yaml's output_crs line (unknown CRS, missing grid).
+  static std::unique_ptr<OutputCrs> Of(const Survey& survey);
+
+  // The three comment lines naming the CRS, and crs_x, crs_y, crs_z after
+  // `columns`, before a CSV's header.
+  void AddHeader(CsvWriter* csv, std::vector<std::string>* columns) const;
+  // The row's crs_x, crs_y, crs_z of a WGS84 position. Throws InputError
+  // naming survey.yaml's output_crs line when PROJ cannot convert it.
+  void AddColumns(const Geodetic& wgs84, CsvWriter* csv) const;
+  Eigen::Vector3d FromWgs84(const Geodetic& wgs84) const;
+  // A database vertex (crossing_id, band, db_vertex) in WGS84; InputError
+  // naming `file` when the survey's database lacks it.
+  Geodetic DatabaseVertex(const std::string& crossing_id, int band, int vertex,
+                          const std::string& file) const;
+  // The survey's ENU frame (gcp_residuals.csv's d_enu from the vertex).
+  const LocalFrame& frame() const { return frame_; }
+  // bands.geojson's "crs" member (GeoJSON 2008's named CRS).
+  nlohmann::json GeoJsonMember() const;
+  std::string Description() const;
+
+ private:
+  OutputCrs(CrsTransformer transformer, int line, LocalFrame frame);
+
+  CrsTransformer transformer_;
+  int line_;  // survey.yaml's output_crs line
+  LocalFrame frame_;
+  std::map<std::tuple<std::string, int, int>, Geodetic> vertices_;
+};
 
 }  // namespace zebrageo
 

@@ -14,22 +14,13 @@
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / kPi;
 // Gaps listed one by one in the warnings before "and N more".
 constexpr int kMaxListedGaps = 3;
-
-// Text of a number for messages, with `decimals` decimals.
-std::string Fixed(double value, int decimals) {
-  std::ostringstream text;
-  text.setf(std::ios::fixed);
-  text.precision(decimals);
-  text << value;
-  return text.str();
-}
 
 // A sample interval for messages: 3 significant digits ("0.01", "0.2").
 std::string Interval(double seconds) {
@@ -41,12 +32,13 @@ std::string Interval(double seconds) {
 
 // "850 m" or "6012 km" (message text).
 std::string Distance(double metres) {
-  if (metres < 10e3) return Fixed(metres, 0) + " m";
-  return Fixed(metres / 1e3, 0) + " km";
+  if (metres < 10e3) return FormatFixed(metres, 0) + " m";
+  return FormatFixed(metres / 1e3, 0) + " km";
 }
 
 std::string LatLon(const Geodetic& g) {
-  return "(" + Fixed(g.lat_deg, 6) + ", " + Fixed(g.lon_deg, 6) + ")";
+  return "(" + FormatFixed(g.lat_deg, 6) + ", " + FormatFixed(g.lon_deg, 6) +
+         ")";
 }
 
 double GeodesicDistance(const Geodetic& a, const Geodetic& b) {
@@ -68,13 +60,6 @@ double WrapPi(double angle) {
   double wrapped = std::remainder(angle, 2.0 * kPi);
   if (wrapped <= -kPi) wrapped += 2.0 * kPi;
   return wrapped;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2,
-                   values.end());
-  return values[values.size() / 2];
 }
 
 // Up to `count` samples spread evenly over the trajectory (distance
@@ -133,9 +118,9 @@ HeadingDisagreement MeasureHeadingDisagreement(
     // The numbers of the file taken as radians: the attitude was divided by
     // 180 / pi when read.
     const TrajectorySample& s = samples[(i + j) / 2];
-    const Attitude radians{s.attitude.roll * kRadToDeg,
-                           s.attitude.pitch * kRadToDeg,
-                           s.attitude.heading * kRadToDeg};
+    const Attitude radians{RadToDeg(s.attitude.roll),
+                           RadToDeg(s.attitude.pitch),
+                           RadToDeg(s.attitude.heading)};
     as_radians.push_back(std::abs(WrapPi(
         course - ForwardYaw(frame.RotationEnuFromBody(s.position, radians)))));
     if (result.first_line == 0) result.first_line = samples[i].line;
@@ -154,7 +139,7 @@ HeadingDisagreement MeasureHeadingDisagreement(
 // a swap that brings two files together could then be in either.
 std::optional<bool> TrajectoryLooksSwapped(const Trajectory& trajectory,
                                            const PlausibilityOptions& options) {
-  const double limit_rad = options.max_heading_disagreement_deg / kRadToDeg;
+  const double limit_rad = DegToRad(options.max_heading_disagreement_deg);
   auto follows_heading =
       [&](const std::vector<TrajectorySample>& samples) -> std::optional<bool> {
     const LocalFrame frame(samples.front().position);
@@ -189,7 +174,7 @@ void CheckHeading(const PlausibilityInput& input,
                "of travel";
     return;
   }
-  const double limit_rad = options.max_heading_disagreement_deg / kRadToDeg;
+  const double limit_rad = DegToRad(options.max_heading_disagreement_deg);
   if (d.median_as_degrees_rad <= limit_rad) return;
   const std::string where =
       " (median over " + std::to_string(d.chords) + " stretches of " +
@@ -201,14 +186,14 @@ void CheckHeading(const PlausibilityInput& input,
         "columns 'roll', 'pitch', 'heading' look like radians, not degrees: "
         "read as degrees, the heading differs from the direction of travel "
         "by " +
-            Fixed(d.median_as_degrees_rad * kRadToDeg, 1) +
+            FormatFixed(RadToDeg(d.median_as_degrees_rad), 1) +
             " deg, read as radians by " +
-            Fixed(d.median_as_radians_rad * kRadToDeg, 1) + " deg" + where);
+            FormatFixed(RadToDeg(d.median_as_radians_rad), 1) + " deg" + where);
   }
   throw InputError(
       file, 0,
       "column 'heading' differs from the direction of travel by " +
-          Fixed(d.median_as_degrees_rad * kRadToDeg, 1) + " deg" + where +
+          FormatFixed(RadToDeg(d.median_as_degrees_rad), 1) + " deg" + where +
           ", more than max_heading_disagreement_deg = " +
           FormatDouble(options.max_heading_disagreement_deg) +
           ": the heading must be degrees clockwise from true north of the "
@@ -405,7 +390,7 @@ void CheckRate(const PlausibilityInput& input,
   // 5% slack: time stamps rounded to the millisecond.
   if (!(interval > 1.05 / options.min_rate_hz)) return;
   warnings->push_back(
-      input.trajectory_file + ": " + Fixed(1.0 / interval, 1) +
+      input.trajectory_file + ": " + FormatFixed(1.0 / interval, 1) +
       " Hz (median sample interval " + Interval(interval) +
       " s) is below the " + FormatDouble(options.min_rate_hz) +
       " Hz the survey format asks for: poses are interpolated over " +
@@ -415,7 +400,7 @@ void CheckRate(const PlausibilityInput& input,
 
 std::string GapText(const TrajectoryGap& gap,
                     const std::vector<TrajectorySample>& samples) {
-  return Fixed(gap.duration(), 2) +
+  return FormatFixed(gap.duration(), 2) +
          " s with no sample (t = " + FormatDouble(gap.start_time) +
          " on line " + std::to_string(samples[gap.before].line) + " to " +
          FormatDouble(gap.end_time) + " on line " +
@@ -500,28 +485,17 @@ void CheckGaps(const PlausibilityInput& input,
 }  // namespace
 
 std::string PlausibilityOptions::Check() const {
-  const std::string gap_problem = gaps.Check();
-  if (!gap_problem.empty()) return "gaps." + gap_problem;
-  const std::pair<const char*, double> positive[] = {
-      {"max_exposure_gap_s", max_exposure_gap_s},
-      {"min_rate_hz", min_rate_hz},
-      {"heading_chord_s", heading_chord_s},
-      {"max_heading_disagreement_deg", max_heading_disagreement_deg},
-      {"max_origin_distance_m", max_origin_distance_m},
-      {"max_database_distance_m", max_database_distance_m}};
-  for (const auto& [name, value] : positive) {
-    if (!(value > 0.0)) {
-      return std::string(name) + " = " + FormatDouble(value) + ": must be > 0";
-    }
-  }
-  if (!(min_speed_mps >= 0.0)) {
-    return "min_speed_mps = " + FormatDouble(min_speed_mps) + ": must be >= 0";
-  }
-  if (min_heading_chords < 1) {
-    return "min_heading_chords = " + std::to_string(min_heading_chords) +
-           ": must be >= 1";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_NESTED(check, gaps);
+  OPTION_GT(check, max_exposure_gap_s, 0.0);
+  OPTION_GT(check, min_rate_hz, 0.0);
+  OPTION_GT(check, heading_chord_s, 0.0);
+  OPTION_GT(check, max_heading_disagreement_deg, 0.0);
+  OPTION_GT(check, max_origin_distance_m, 0.0);
+  OPTION_GT(check, max_database_distance_m, 0.0);
+  OPTION_GE(check, min_speed_mps, 0.0);
+  OPTION_GE(check, min_heading_chords, 1);
+  return check.problem();
 }
 
 std::vector<std::string> CheckPlausibility(const PlausibilityInput& input,

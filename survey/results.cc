@@ -13,6 +13,7 @@
 #include "survey/csv.h"
 #include "survey/geojson_internal.h"
 #include "survey/input_error.h"
+#include "survey/output_crs.h"
 
 namespace zebrageo {
 namespace {
@@ -212,11 +213,13 @@ std::vector<ReconstructedVertex> ReadReconstructedBands(
 
 void WriteMatches(const std::vector<VertexMatch>& matches,
                   const std::vector<std::string>& comments,
-                  const std::string& path) {
+                  const std::string& path, const OutputCrs* crs) {
   AtomicFile file(path);
   CsvWriter csv(&file.stream());
   WriteComments(&csv, comments);
-  csv.Header(MatchColumns());
+  std::vector<std::string> columns = MatchColumns();
+  if (crs != nullptr) crs->AddHeader(&csv, &columns);
+  csv.Header(columns);
   for (const VertexMatch& m : matches) {
     csv.Add(m.exposure_id)
         .Add(m.band_id)
@@ -224,6 +227,11 @@ void WriteMatches(const std::vector<VertexMatch>& matches,
         .Add(CheckedField(m.crossing_id, "crossing_id"))
         .Add(m.band)
         .Add(m.db_vertex);
+    if (crs != nullptr) {
+      crs->AddColumns(
+          crs->DatabaseVertex(m.crossing_id, m.band, m.db_vertex, kMatchesFile),
+          &csv);
+    }
     csv.EndRow();
   }
   file.Commit();
@@ -347,13 +355,15 @@ std::vector<CrossingDecision> ReadCrossingDecisions(
 // poses.csv
 
 void WriteCameraPoses(const std::vector<CameraPose>& poses,
-                      const std::string& path) {
+                      const std::string& path, const OutputCrs* crs) {
   AtomicFile file(path);
   CsvWriter csv(&file.stream());
   csv.Comment(
       "camera projection centres; q = Hamilton quaternion (w first) of the "
       "camera-to-ENU rotation");
-  csv.Header(PoseColumns());
+  std::vector<std::string> columns = PoseColumns();
+  if (crs != nullptr) crs->AddHeader(&csv, &columns);
+  csv.Header(columns);
   for (const CameraPose& p : poses) {
     csv.Add(p.exposure_id)
         .Add(CheckedField(p.camera, "camera"))
@@ -368,6 +378,7 @@ void WriteCameraPoses(const std::vector<CameraPose>& poses,
         .Add(p.q_enu_cam.x())
         .Add(p.q_enu_cam.y())
         .Add(p.q_enu_cam.z());
+    if (crs != nullptr) crs->AddColumns(p.position, &csv);
     csv.EndRow();
   }
   file.Commit();
@@ -425,7 +436,7 @@ const char* GcpStatusName(GcpStatus status) {
 }
 
 void WriteGcpResiduals(const std::vector<GcpResidual>& residuals,
-                       const std::string& path) {
+                       const std::string& path, const OutputCrs* crs) {
   AtomicFile file(path);
   CsvWriter csv(&file.stream());
   csv.Comment(
@@ -435,6 +446,7 @@ void WriteGcpResiduals(const std::vector<GcpResidual>& residuals,
   std::vector<std::string> columns = GcpColumns();
   columns.push_back("status");
   columns.push_back("normalized_residual");
+  if (crs != nullptr) crs->AddHeader(&csv, &columns);
   csv.Header(columns);
   for (const GcpResidual& r : residuals) {
     csv.Add(CheckedField(r.crossing_id, "crossing_id"))
@@ -449,6 +461,18 @@ void WriteGcpResiduals(const std::vector<GcpResidual>& residuals,
         .Add(r.n_images)
         .Add(GcpStatusName(r.status))
         .AddFixed(r.normalized_residual, 2);
+    if (crs != nullptr) {
+      // The adjusted position: the database vertex plus the offsets as
+      // written (0.1 mm).
+      const Eigen::Vector3d d(ParseDouble(FormatFixed(r.d_enu.x(), 4)),
+                              ParseDouble(FormatFixed(r.d_enu.y(), 4)),
+                              ParseDouble(FormatFixed(r.d_enu.z(), 4)));
+      const Geodetic db = crs->DatabaseVertex(r.crossing_id, r.band, r.vertex,
+                                              kGcpResidualsFile);
+      crs->AddColumns(
+          crs->frame().GeodeticFromEnu(crs->frame().EnuFromGeodetic(db) + d),
+          &csv);
+    }
     csv.EndRow();
   }
   file.Commit();

@@ -17,6 +17,8 @@
 
 namespace zebrageo {
 
+class OutputCrs;
+
 // File names inside a results folder.
 inline constexpr char kReconstructedBandsFile[] = "reconstructed_bands.csv";
 inline constexpr char kMatchesFile[] = "matches.csv";
@@ -57,9 +59,11 @@ struct VertexMatch {
   int band = 0;       // 1-based band of the database crossing
   int db_vertex = 0;  // index 0..3 in the database polygon's ring
 };
+// With `crs` (survey/output_crs.h): columns crs_x, crs_y, crs_z of the
+// matched database vertex.
 void WriteMatches(const std::vector<VertexMatch>& matches,
                   const std::vector<std::string>& comments,
-                  const std::string& path);
+                  const std::string& path, const OutputCrs* crs = nullptr);
 std::vector<VertexMatch> ReadMatches(const std::string& path,
                                      const std::string& display_name);
 
@@ -102,8 +106,9 @@ struct CameraPose {
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();
   Eigen::Quaterniond q_enu_cam = Eigen::Quaterniond::Identity();
 };
+// With `crs`: columns crs_x, crs_y, crs_z of lat, lon, h.
 void WriteCameraPoses(const std::vector<CameraPose>& poses,
-                      const std::string& path);
+                      const std::string& path, const OutputCrs* crs = nullptr);
 std::vector<CameraPose> ReadCameraPoses(const std::string& path,
                                         const std::string& display_name);
 
@@ -126,8 +131,10 @@ struct GcpResidual {
   GcpStatus status = GcpStatus::kControl;
   double normalized_residual = 0.0;  // residual / its sd (blunder test)
 };
+// With `crs`: columns crs_x, crs_y, crs_z of the database vertex plus
+// the written de, dn, du.
 void WriteGcpResiduals(const std::vector<GcpResidual>& residuals,
-                       const std::string& path);
+                       const std::string& path, const OutputCrs* crs = nullptr);
 std::vector<GcpResidual> ReadGcpResiduals(const std::string& path,
                                           const std::string& display_name);
 
@@ -139,8 +146,10 @@ struct AdjustedBand {
   int64_t band_id = 0;
   int64_t exposure_id = 0;
 };
+// With `crs`: coordinates in the output CRS and a top-level "crs" member.
 void WriteAdjustedBands(const std::vector<AdjustedBand>& bands,
-                        const std::string& path);
+                        const std::string& path,
+                        const OutputCrs* crs = nullptr);
 // Reads bands.geojson back (scoring tools, tests). Throws InputError naming
 // the line of a bad feature.
 std::vector<AdjustedBand> ReadAdjustedBands(const std::string& path,

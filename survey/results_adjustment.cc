@@ -371,9 +371,4 @@ AdjustmentRecord ReadAdjustmentRecord(const std::string& path,
   return record;
 }
 
-void WriteReportJson(const json& report, const std::string& path, int indent) {
-  WriteFileAtomically(
-      path, [&](std::ostream& out) { out << report.dump(indent) << "\n"; });
-}
-
 }  // namespace zebrageo

@@ -154,13 +154,6 @@ void WriteAdjustmentRecord(const AdjustmentRecord& record,
 AdjustmentRecord ReadAdjustmentRecord(const std::string& path,
                                       const std::string& display_name);
 
-// report.json: built by the report (pipeline/report.h), or the minimal one
-// `zebrageo adjust` leaves; the one writer of the file. `indent` as
-// nlohmann::json::dump (the report's is 1, the adjust stage's minimal one
-// 2).
-void WriteReportJson(const nlohmann::json& report, const std::string& path,
-                     int indent = 1);
-
 }  // namespace zebrageo
 
 #endif  // ZEBRAGEO_SURVEY_RESULTS_ADJUSTMENT_H_

@@ -6,22 +6,14 @@
 #include "survey/csv.h"
 #include "survey/geojson_internal.h"
 #include "survey/input_error.h"
+#include "survey/output_crs.h"
 #include "survey/results.h"
+#include "survey/text_file.h"
 
 namespace zebrageo {
 namespace {
 
 using nlohmann::json;
-
-std::string ReadWholeFile(const std::string& path,
-                          const std::string& display_name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(display_name, 0, "cannot read " + path);
-  return text.str();
-}
 
 }  // namespace
 
@@ -29,25 +21,40 @@ std::string ReadWholeFile(const std::string& path,
 // bands.geojson
 
 void WriteAdjustedBands(const std::vector<AdjustedBand>& bands,
-                        const std::string& path) {
+                        const std::string& path, const OutputCrs* crs) {
   using geojson_internal::JsonString;
   using geojson_internal::PositionText;
   // One feature per line, like roadmarks.geojson.
-  std::string body = "{\"type\": \"FeatureCollection\", \"features\": [\n";
+  std::string body =
+      crs == nullptr ? "{\"type\": \"FeatureCollection\", \"features\": [\n"
+                     : "{\"type\": \"FeatureCollection\", \"crs\": " +
+                           crs->GeoJsonMember().dump() + ", \"features\": [\n";
   for (size_t i = 0; i < bands.size(); ++i) {
     const AdjustedBand& band = bands[i];
     std::string ring;
     for (int k = 0; k <= 4; ++k) {
       ring += (k > 0 ? ", " : "") + PositionText(band.corners[k % 4]);
     }
-    body += std::string(i > 0 ? ",\n" : "") +
-            "{\"type\": \"Feature\", \"geometry\": {\"type\": \"Polygon\", "
-            "\"coordinates\": [[" +
-            ring + "]]}, \"properties\": {\"crossing_id\": " +
-            (band.crossing_id ? JsonString(*band.crossing_id) : "null") +
-            ", \"band\": " + (band.band ? std::to_string(*band.band) : "null") +
-            ", \"band_id\": " + std::to_string(band.band_id) +
-            ", \"exposure_id\": " + std::to_string(band.exposure_id) + "}}";
+    std::string feature =
+        "{\"type\": \"Feature\", \"geometry\": {\"type\": \"Polygon\", "
+        "\"coordinates\": [[" +
+        ring + "]]}, \"properties\": {\"crossing_id\": " +
+        (band.crossing_id ? JsonString(*band.crossing_id) : "null") +
+        ", \"band\": " + (band.band ? std::to_string(*band.band) : "null") +
+        ", \"band_id\": " + std::to_string(band.band_id) +
+        ", \"exposure_id\": " + std::to_string(band.exposure_id) + "}}";
+    if (crs != nullptr) {
+      // In the output CRS (GeoJSON 2008): the feature as nlohmann writes it.
+      json f = json::parse(feature);
+      json xyz_ring = json::array();
+      for (int k = 0; k <= 4; ++k) {
+        const Eigen::Vector3d xyz = crs->FromWgs84(band.corners[k % 4]);
+        xyz_ring.push_back({xyz.x(), xyz.y(), xyz.z()});
+      }
+      f["geometry"]["coordinates"] = json::array({xyz_ring});
+      feature = f.dump();
+    }
+    body += std::string(i > 0 ? ",\n" : "") + feature;
   }
   body += "\n]}\n";
   AtomicFile file(path);
@@ -57,7 +64,7 @@ void WriteAdjustedBands(const std::vector<AdjustedBand>& bands,
 
 std::vector<AdjustedBand> ReadAdjustedBands(const std::string& path,
                                             const std::string& display_name) {
-  const std::string text = ReadWholeFile(path, display_name);
+  const std::string text = ReadTextFile(path, display_name);
   const json root = geojson_internal::ParseJson(text, display_name);
   if (!root.is_object() || !root.contains("type") ||
       root["type"] != "FeatureCollection" || !root.contains("features") ||

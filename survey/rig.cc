@@ -13,6 +13,7 @@
 #include "survey/csv.h"
 #include "survey/image_io.h"
 #include "survey/input_error.h"
+#include "survey/text_file.h"
 #include "survey/yaml_document.h"
 
 namespace zebrageo {
@@ -235,16 +236,6 @@ class RigParser {
   std::string display_name_;
 };
 
-std::string ReadWholeFile(const std::string& path,
-                          const std::string& display_name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(display_name, 0, "cannot read " + path);
-  return text.str();
-}
-
 // "[a, b, c]"; `group` > 0 puts two spaces between groups (matrix rows).
 std::string NumberList(const double* values, int count, int group = 0) {
   std::string list = "[";
@@ -346,7 +337,7 @@ Rig ParseRig(const std::string& yaml_text, const std::string& display_name) {
 }
 
 Rig ReadRig(const std::string& path, const std::string& display_name) {
-  return ParseRig(ReadWholeFile(path, display_name), display_name);
+  return ParseRig(ReadTextFile(path, display_name), display_name);
 }
 
 void WriteRig(const Rig& rig, const std::string& path) {

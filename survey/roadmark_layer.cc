@@ -18,6 +18,7 @@
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -375,16 +376,14 @@ OGRLayer* ChooseLayer(GDALDataset* dataset, const std::string& name,
 }  // namespace
 
 std::string RoadmarkLayerOptions::Check() const {
-  if (source.empty()) return "source: empty";
-  for (const auto& [name, value] :
-       {std::pair{"default_sigma_xy_m", default_sigma_xy_m},
-        std::pair{"default_sigma_z_m", default_sigma_z_m},
-        std::pair{"sigma_z_without_height_m", sigma_z_without_height_m}}) {
-    if (!(value > 0.0) || !std::isfinite(value)) {
-      return std::string(name) + " = " + FormatDouble(value) + ": must be > 0";
-    }
-  }
-  return crs_options.Check();
+  OptionCheck check;
+  check.Require(!source.empty(), "source", std::string("\"\""),
+                "must not be empty");
+  OPTION_GT(check, default_sigma_xy_m, 0.0);
+  OPTION_GT(check, default_sigma_z_m, 0.0);
+  OPTION_GT(check, sigma_z_without_height_m, 0.0);
+  OPTION_NESTED(check, crs_options);
+  return check.problem();
 }
 
 std::string RedactedSource(const std::string& source) {

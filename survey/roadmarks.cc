@@ -14,6 +14,7 @@
 #include "survey/csv.h"
 #include "survey/geojson_internal.h"
 #include "survey/input_error.h"
+#include "survey/text_file.h"
 
 namespace zebrageo {
 namespace {
@@ -430,16 +431,6 @@ class RoadmarkParser {
   RoadmarkDatabase database_;
 };
 
-std::string ReadWholeFile(const std::string& path,
-                          const std::string& display_name) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(display_name, 0, "cannot read " + path);
-  return text.str();
-}
-
 std::string SigmaText(double sigma) {
   if (!std::isfinite(sigma) || sigma < 0.0) {
     throw std::invalid_argument("WriteRoadmarks: sigma must be finite, >= 0");
@@ -456,7 +447,7 @@ RoadmarkDatabase ParseRoadmarks(const std::string& text,
 
 RoadmarkDatabase ReadRoadmarks(const std::string& path,
                                const std::string& display_name) {
-  return ParseRoadmarks(ReadWholeFile(path, display_name), display_name);
+  return ParseRoadmarks(ReadTextFile(path, display_name), display_name);
 }
 
 void WriteRoadmarks(const RoadmarkDatabase& database, const std::string& path) {

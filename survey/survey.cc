@@ -12,6 +12,8 @@
 
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -23,16 +25,10 @@ constexpr char kManifestFile[] = "survey.yaml";
 }  // namespace
 
 std::string SurveyLoadOptions::Check() const {
-  if (!(max_missing_image_fraction >= 0.0 &&
-        max_missing_image_fraction <= 1.0)) {
-    std::ostringstream message;
-    message << "max_missing_image_fraction = " << max_missing_image_fraction
-            << ": must be in [0, 1]";
-    return message.str();
-  }
-  const std::string problem = plausibility.Check();
-  if (!problem.empty()) return "plausibility." + problem;
-  return "";
+  OptionCheck check;
+  OPTION_IN(check, max_missing_image_fraction, "[", 0.0, 1.0, "]");
+  OPTION_NESTED(check, plausibility);
+  return check.problem();
 }
 
 std::string Survey::PathOf(const std::string& relative) const {
@@ -98,7 +94,7 @@ double RoadHeightBelow(const std::vector<TrajectorySample>& trajectory,
                        double lat_deg, double lon_deg) {
   double best = std::numeric_limits<double>::infinity();
   double height = 0.0;
-  const double scale = std::cos(lat_deg * 3.14159265358979323846 / 180.0);
+  const double scale = std::cos(DegToRad(lat_deg));
   for (const TrajectorySample& s : trajectory) {
     const double dlat = s.position.lat_deg - lat_deg;
     const double dlon = (s.position.lon_deg - lon_deg) * scale;

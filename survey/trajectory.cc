@@ -10,11 +10,11 @@
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
+#include "survey/output_crs.h"
 
 namespace zebrageo {
 namespace {
-
-constexpr double kDegToRad = kPi / 180.0;
 
 const std::vector<std::string>& TrajectoryColumns() {
   static const std::vector<std::string> kColumns = {
@@ -56,14 +56,14 @@ std::vector<TrajectorySample> SamplesFromTable(
         table.Fail(row, error.what());
       }
     }
-    s.attitude.roll = table.GetDouble(row, "roll") * kDegToRad;
-    s.attitude.pitch = table.GetDouble(row, "pitch") * kDegToRad;
-    s.attitude.heading = table.GetDouble(row, "heading") * kDegToRad;
+    s.attitude.roll = DegToRad(table.GetDouble(row, "roll"));
+    s.attitude.pitch = DegToRad(table.GetDouble(row, "pitch"));
+    s.attitude.heading = DegToRad(table.GetDouble(row, "heading"));
     s.sd_enu_m = {table.GetDouble(row, "sd_e"), table.GetDouble(row, "sd_n"),
                   table.GetDouble(row, "sd_u")};
-    s.sd_attitude_rad = {table.GetDouble(row, "sd_roll") * kDegToRad,
-                         table.GetDouble(row, "sd_pitch") * kDegToRad,
-                         table.GetDouble(row, "sd_heading") * kDegToRad};
+    s.sd_attitude_rad = {DegToRad(table.GetDouble(row, "sd_roll")),
+                         DegToRad(table.GetDouble(row, "sd_pitch")),
+                         DegToRad(table.GetDouble(row, "sd_heading"))};
     if (std::abs(s.position.lat_deg) > 90.0) {
       table.Fail(row, "latitude " + FormatDouble(s.position.lat_deg) +
                           " is outside [-90, 90]");
@@ -164,14 +164,10 @@ bool Trajectory::InterpolatePose(double time, Pose* pose) const {
 }
 
 std::string TrajectoryGapOptions::Check() const {
-  if (!(factor > 1.0)) {
-    return "factor = " + FormatDouble(factor) + ": must be > 1";
-  }
-  if (!(min_duration_s >= 0.0)) {
-    return "min_duration_s = " + FormatDouble(min_duration_s) +
-           ": must be >= 0";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GT(check, factor, 1.0);
+  OPTION_GE(check, min_duration_s, 0.0);
+  return check.problem();
 }
 
 double MedianSampleInterval(const std::vector<double>& times) {
@@ -226,28 +222,30 @@ std::vector<TrajectorySample> ParseTrajectorySamples(
 }
 
 void WriteTrajectorySamples(const std::vector<TrajectorySample>& samples,
-                            const std::string& path) {
-  constexpr double kRadToDeg = 180.0 / kPi;
+                            const std::string& path, const OutputCrs* crs) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     CsvWriter csv(&out);
-    csv.Header(TrajectoryColumns());
+    std::vector<std::string> columns = TrajectoryColumns();
+    if (crs != nullptr) crs->AddHeader(&csv, &columns);
+    csv.Header(columns);
     for (const TrajectorySample& s : samples) {
-      double heading = std::fmod(s.attitude.heading * kRadToDeg, 360.0);
+      double heading = std::fmod(RadToDeg(s.attitude.heading), 360.0);
       if (heading < 0.0) heading += 360.0;
       if (heading >= 360.0) heading -= 360.0;
       csv.Add(s.time)
           .Add(s.position.lat_deg)
           .Add(s.position.lon_deg)
           .Add(s.position.h_m)
-          .Add(WrapDegrees180(s.attitude.roll * kRadToDeg))
-          .Add(std::clamp(s.attitude.pitch * kRadToDeg, -90.0, 90.0))
+          .Add(WrapDegrees180(RadToDeg(s.attitude.roll)))
+          .Add(std::clamp(RadToDeg(s.attitude.pitch), -90.0, 90.0))
           .Add(heading)
           .Add(s.sd_enu_m.x())
           .Add(s.sd_enu_m.y())
           .Add(s.sd_enu_m.z())
-          .Add(s.sd_attitude_rad.x() * kRadToDeg)
-          .Add(s.sd_attitude_rad.y() * kRadToDeg)
-          .Add(s.sd_attitude_rad.z() * kRadToDeg);
+          .Add(RadToDeg(s.sd_attitude_rad.x()))
+          .Add(RadToDeg(s.sd_attitude_rad.y()))
+          .Add(RadToDeg(s.sd_attitude_rad.z()));
+      if (crs != nullptr) crs->AddColumns(s.position, &csv);
       csv.EndRow();
     }
   });

@@ -19,6 +19,8 @@
 
 namespace zebrageo {
 
+class OutputCrs;
+
 class CrsTransformer;
 
 struct TrajectorySample {
@@ -123,7 +125,8 @@ std::vector<TrajectorySample> ParseTrajectorySamples(
 // Writes samples in the same format, angles normalised (heading [0, 360),
 // roll (-180, 180], pitch [-90, 90]), atomically.
 void WriteTrajectorySamples(const std::vector<TrajectorySample>& samples,
-                            const std::string& path);
+                            const std::string& path,
+                            const OutputCrs* crs = nullptr);
 
 // The sample for an ENU pose (inverse of the frame chain), keeping `time`
 // and the given standard deviations.

@@ -5,6 +5,8 @@
 #include <opencv2/core/eigen.hpp>
 #include <sstream>
 
+#include "survey/option_check.h"
+
 namespace zebrageo {
 namespace {
 
@@ -23,25 +25,16 @@ double RotationAngleRad(const Eigen::Matrix3d& R) {
 }  // namespace
 
 std::string StereoOdometryOptions::Check() const {
-  std::ostringstream message;
-  if (!(max_range_m > 1.0)) {
-    message << "max_range_m = " << max_range_m << ": must be > 1";
-  } else if (!(max_stereo_error_px > 0.0) || !(max_pnp_error_px > 0.0)) {
-    message << "max_stereo_error_px and max_pnp_error_px must be > 0";
-  } else if (min_inliers < 6) {
-    message << "min_inliers = " << min_inliers << ": must be >= 6";
-  } else if (!(max_descriptor_ratio > 0.0 && max_descriptor_ratio <= 1.0)) {
-    message << "max_descriptor_ratio = " << max_descriptor_ratio
-            << ": must be in (0, 1]";
-  } else if (!(min_inlier_share >= 0.0 && min_inlier_share <= 1.0)) {
-    message << "min_inlier_share = " << min_inlier_share
-            << ": must be in [0, 1]";
-  } else if (!(max_translation_change_m > 0.0) ||
-             !(max_rotation_change_rad > 0.0)) {
-    message << "max_translation_change_m and max_rotation_change_rad must be "
-               "> 0";
-  }
-  return message.str();
+  OptionCheck check;
+  OPTION_GT(check, max_range_m, 1.0);
+  OPTION_GT(check, max_stereo_error_px, 0.0);
+  OPTION_GT(check, max_pnp_error_px, 0.0);
+  OPTION_GE(check, min_inliers, 6);
+  OPTION_IN(check, max_descriptor_ratio, "(", 0.0, 1.0, "]");
+  OPTION_IN(check, min_inlier_share, "[", 0.0, 1.0, "]");
+  OPTION_GT(check, max_translation_change_m, 0.0);
+  OPTION_GT(check, max_rotation_change_rad, 0.0);
+  return check.problem();
 }
 
 bool TriangulateStereoPoint(const StereoOdometryOptions& options,

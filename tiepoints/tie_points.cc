@@ -115,7 +115,8 @@ class FeatureGraph {
 
   // Each exposure's images matched within its stereo pairs and with the
   // same camera of the exposure_window exposures before it.
-  void MatchExposures(const std::function<void(int, int)>& progress);
+  void MatchExposures(const std::function<void(int, int)>& progress,
+                      const CancellationToken& cancel);
 
   // The components that make a track, in the order of their roots.
   std::vector<Candidate> Candidates(Rejections* rejected);
@@ -363,11 +364,12 @@ void FeatureGraph::SetCheckedPoses(int e) {
   }
 }
 
-void FeatureGraph::MatchExposures(
-    const std::function<void(int, int)>& progress) {
+void FeatureGraph::MatchExposures(const std::function<void(int, int)>& progress,
+                                  const CancellationToken& cancel) {
   const int num_exposures = static_cast<int>(exposures_.exposures.size());
   const int window = options_.exposure_window;
   for (int e = 0; e < num_exposures; ++e) {
+    cancel.ThrowIfCancelled();  // between exposures
     const Exposure& exposure = exposures_.exposures[e];
     for (int image : exposure.image_of_camera) {
       if (image >= 0) Load(image);
@@ -543,7 +545,8 @@ std::vector<TieTrack> BuildTieTracks(
     const TiePointOptions& options, const std::string& survey_folder,
     const Rig& rig, const Trajectory& trajectory,
     const ExposureTable& exposures, TiePointSummary* summary,
-    const std::function<void(int, int)>& progress) {
+    const std::function<void(int, int)>& progress,
+    const CancellationToken& cancel) {
   const auto start = std::chrono::steady_clock::now();
   const std::string error = options.Check();
   if (!error.empty()) {
@@ -555,7 +558,7 @@ std::vector<TieTrack> BuildTieTracks(
 
   FeatureGraph graph(options, survey_folder, rig, trajectory, exposures,
                      summary);
-  graph.MatchExposures(progress);
+  graph.MatchExposures(progress, cancel);
   Rejections rejected;
   std::vector<Candidate> candidates = graph.Candidates(&rejected);
   VLOG(1) << "tie points: " << rejected.components

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "survey/cancellation.h"
 #include "survey/exposures.h"
 #include "survey/math_util.h"
 #include "survey/rig.h"
@@ -61,6 +62,21 @@ struct TiePointOptions {
 
   // "" when valid, else "field = value: constraint".
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_features_per_image", max_features_per_image);
+    v("orb_levels", orb_levels);
+    v("refine_subpixel", refine_subpixel);
+    v("max_descriptor_ratio", max_descriptor_ratio);
+    v("max_epipolar_distance_px", max_epipolar_distance_px);
+    v("exposure_window", exposure_window);
+    v("max_reprojection_error_px", max_reprojection_error_px);
+    v("max_range_m", max_range_m);
+    v("min_triangulation_angle_rad", min_triangulation_angle_rad);
+    v("min_track_length", min_track_length);
+    v("require_stereo", require_stereo);
+    v("max_tracks_per_exposure", max_tracks_per_exposure);
+  }
 };
 
 // Builds tie-point tracks from the survey's images. Images that cannot be
@@ -72,7 +88,8 @@ std::vector<TieTrack> BuildTieTracks(
     const TiePointOptions& options, const std::string& survey_folder,
     const Rig& rig, const Trajectory& trajectory,
     const ExposureTable& exposures, TiePointSummary* summary,
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const CancellationToken& cancel = {});
 
 }  // namespace zebrageo
 

@@ -1,15 +1,18 @@
 // `zebrageo adjust SURVEY -o RESULTS`: reads reconstructed_bands.csv and
-// matches.csv, adjusts the trajectory (pipeline/stages.h) and writes
+// matches.csv, adjusts the trajectory (pipeline/adjust_stage.h) and writes
 // trajectory_corrected.csv, poses.csv, gcp_residuals.csv, bands.geojson,
-// adjustment.json, a minimal report.json and colmap/.
+// adjustment.json and colmap/, then the report (report.json, report.html).
+#include <chrono>
 #include <memory>
 
+#include "pipeline/adjust_stage.h"
 #include "pipeline/exit_codes.h"
+#include "pipeline/report_stage.h"
 #include "pipeline/results_session.h"
-#include "pipeline/stages.h"
+#include "pipeline/run_options.h"
 #include "survey/math_util.h"
 #include "tools/commands.h"
-#include "tools/progress.h"
+#include "tools/progress_bars.h"
 
 namespace zebrageo {
 namespace {
@@ -19,17 +22,24 @@ struct AdjustArguments {
   bool tie_points = true;
   bool lines = true;
   bool self_calibrate = false;
-  double check_share = AdjustmentOptions().check_crossing_share;
-  int threads = AdjustmentOptions().solver.num_threads;
-  double sideslip_sigma_deg = RadToDeg(AdjustmentOptions().sideslip_sigma_rad);
+  double check_share = RunOptions().adjustment.control.check_crossing_share;
+  int threads = RunOptions().adjustment.solver.num_threads;
+  double sideslip_sigma_deg =
+      RadToDeg(RunOptions().adjustment.vehicle_motion.sideslip_sigma_rad);
 };
 
 void RunAdjust(const AdjustArguments& args) {
-  AdjustmentOptions options;
-  options.check_crossing_share = args.check_share;
-  options.self_calibrate_rig = args.self_calibrate;
-  options.solver.num_threads = args.threads;
-  options.sideslip_sigma_rad = DegToRad(args.sideslip_sigma_deg);
+  RunOptions options;
+  options.tie_points = args.tie_points;
+  options.lines = args.lines;
+  // The second registration pass is `zebrageo match --second-pass`.
+  options.rematch = false;
+  AdjustmentOptions& adjustment = options.adjustment;
+  adjustment.control.check_crossing_share = args.check_share;
+  adjustment.rig_calibration.self_calibrate_rig = args.self_calibrate;
+  adjustment.solver.num_threads = args.threads;
+  adjustment.vehicle_motion.sideslip_sigma_rad =
+      DegToRad(args.sideslip_sigma_deg);
   const std::string problem = options.Check();
   if (!problem.empty()) throw UsageError("adjust: " + problem);
   ResultsSession session(args.stage.results,
@@ -41,8 +51,18 @@ void RunAdjust(const AdjustArguments& args) {
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
   session.Open();
   StageResults results(args.stage.results);
-  RunAdjustStage(survey, &results, options, args.tie_points, args.lines,
-                 ProgressBars());
+  const auto start = std::chrono::steady_clock::now();
+  ReportInputs inputs;
+  inputs.warnings = RunAdjustStage(survey, &results, options, ProgressBars(),
+                                   CancelOnSignal());
+  inputs.timings = {
+      {"adjust",
+       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+           .count(),
+       false}};
+  inputs.survey = &survey;
+  inputs.results_folder = args.stage.results;
+  RunReportStage(inputs, options.report);
   session.Succeeded();
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "survey/cancellation.h"
 #include "survey/survey.h"
 
 namespace zebrageo {
@@ -46,6 +47,11 @@ CLI::App* AddStageSubcommand(CLI::App* app, const std::string& name,
 void AddAllowOutsidePathsFlag(CLI::App* subcommand, bool* allow);
 // How a stage command loads its survey.
 SurveyLoadOptions LoadOptionsOf(const StageArguments& args);
+// A token SIGINT and SIGTERM cancel (the handlers are installed on the first
+// call): the stage in progress stops at its next checkpoint and writes
+// nothing; main exits with kExitCancelled. A second signal ends the process
+// at once.
+CancellationToken CancelOnSignal();
 // --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_rad, in
 // degrees here).
 void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg);

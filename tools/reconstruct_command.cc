@@ -1,18 +1,17 @@
 // `zebrageo reconstruct SURVEY -o RESULTS`: the zebra bands of every stereo
-// pair in 3D (body frame), written to RESULTS/reconstructed_bands.csv.
-#include <glog/logging.h>
-
+// pair in 3D (body frame), written to RESULTS/reconstructed_bands.csv
+// (pipeline/reconstruct_stage.h).
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/reconstruct_stage.h"
 #include "pipeline/results_session.h"
-#include "pipeline/stages.h"
-#include "reconstruction/reconstruction.h"
+#include "pipeline/run_options.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
-#include "tools/progress.h"
+#include "tools/progress_bars.h"
 
 namespace zebrageo {
 namespace {
@@ -22,27 +21,32 @@ struct ReconstructArguments {
   int threads = 0;
   std::string debug_images;
   double nominal_camera_height_m =
-      ReconstructionOptions().search.nominal_camera_height_m;
-  double ground_pixel_m = ReconstructionOptions().rectification.ground_pixel_m;
+      RunOptions().reconstruction.search.nominal_camera_height_m;
+  double ground_pixel_m =
+      RunOptions().reconstruction.rectification.ground_pixel_m;
   double min_long_side_length_m =
-      ReconstructionOptions().long_sides.min_long_side_length_m;
+      RunOptions().reconstruction.long_sides.min_long_side_length_m;
   bool lines = false;  // also the road lines (issue 9)
 };
 
-ReconstructionOptions OptionsFrom(const ReconstructArguments& args) {
-  ReconstructionOptions options;
+RunOptions OptionsFrom(const ReconstructArguments& args) {
+  RunOptions options;
+  options.lines = args.lines;
   options.threads = args.threads;
-  options.debug_image_folder = args.debug_images;
-  options.search.nominal_camera_height_m = args.nominal_camera_height_m;
-  options.rectification.ground_pixel_m = args.ground_pixel_m;
-  options.long_sides.min_long_side_length_m = args.min_long_side_length_m;
+  ReconstructionOptions& reconstruction = options.reconstruction;
+  reconstruction.threads = args.threads;
+  reconstruction.debug_image_folder = args.debug_images;
+  reconstruction.search.nominal_camera_height_m = args.nominal_camera_height_m;
+  reconstruction.rectification.ground_pixel_m = args.ground_pixel_m;
+  reconstruction.long_sides.min_long_side_length_m =
+      args.min_long_side_length_m;
   const std::string error = options.Check();
   if (!error.empty()) throw UsageError(error);
   return options;
 }
 
 void RunReconstruct(const ReconstructArguments& args) {
-  const ReconstructionOptions options = OptionsFrom(args);
+  const RunOptions options = OptionsFrom(args);
   ResultsSession session(args.stage.results,
                          ResultsSession::OnError::kKeepOutputs);
   SurveyLoadOptions load_options = LoadOptionsOf(args.stage);
@@ -50,16 +54,10 @@ void RunReconstruct(const ReconstructArguments& args) {
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
   session.Open();
   ProgressBar bar("reconstruct");
-  RoadPlane road_plane;
   StageResults results(args.stage.results);
-  RunReconstructStage(survey, options, &results, bar.Callback(), &road_plane);
+  RunReconstructStage(survey, &results, options, bar.Callback(), ProgressBars(),
+                      CancelOnSignal());
   bar.Finish();
-  if (args.lines) {
-    ProgressBar lines_bar("road lines");
-    RunRoadLinesStage(survey, road_plane, RoadLineOptions(), args.threads,
-                      &results, lines_bar.Callback());
-    lines_bar.Finish();
-  }
   session.Succeeded();
 }
 

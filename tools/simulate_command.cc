@@ -11,7 +11,7 @@
 #include "simulator/simulator.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
-#include "tools/progress.h"
+#include "tools/progress_bars.h"
 
 namespace zebrageo {
 namespace {

@@ -1,4 +1,8 @@
 // What the stage commands share.
+#include <signal.h>
+
+#include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -55,6 +59,35 @@ void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg) {
                    "the heading between crossings. 0: not used")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+}
+
+namespace {
+
+// The flag SIGINT and SIGTERM set (a lock-free atomic store is
+// async-signal-safe); a second signal ends the process at once.
+std::atomic<bool>* signal_flag = nullptr;
+
+extern "C" void OnCancelSignal(int signal_number) {
+  if (signal_flag->exchange(true)) {
+    std::signal(signal_number, SIG_DFL);
+    std::raise(signal_number);
+  }
+}
+
+}  // namespace
+
+CancellationToken CancelOnSignal() {
+  static const CancellationToken token = [] {
+    CancellationToken t = CancellationToken::Cancellable();
+    signal_flag = t.flag();
+    struct sigaction action {};
+    action.sa_handler = OnCancelSignal;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+    return t;
+  }();
+  return token;
 }
 
 std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,

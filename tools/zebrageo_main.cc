@@ -11,9 +11,10 @@
 #include <vector>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/version.h"
+#include "survey/cancellation.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
-#include "tools/version.h"
 
 namespace zebrageo {
 namespace {
@@ -49,7 +50,8 @@ int Main(int argc, char** argv) {
       ->check(CLI::Range(0, 3));
   app.footer(
       "Exit status: 0 success (warnings in report.json), 1 invalid input, "
-      "2 usage, 3 stage failed, 4 not implemented, 5 internal error.");
+      "2 usage, 3 stage failed, 4 not implemented, 5 internal error, "
+      "6 cancelled.");
 
   std::vector<Command> commands;
   AddSimulateCommand(&app, &commands);
@@ -85,6 +87,10 @@ int Main(int argc, char** argv) {
     return Fail(kExitNotImplemented, error.what());
   } catch (const StageFailedError& error) {
     return Fail(kExitStageFailed, error.what());
+  } catch (const CancelledError&) {
+    return Fail(kExitCancelled,
+                "cancelled: the stage in progress wrote nothing; run the "
+                "command again to resume");
   } catch (const std::bad_alloc&) {
     return Fail(kExitInternalError, "out of memory");
   } catch (const std::exception& error) {

@@ -160,24 +160,6 @@ Eigen::Vector2d ExportPrincipalPoint(const BalProblem& problem, int camera) {
   return Eigen::Vector2d(half, half);
 }
 
-std::vector<std::string> DataLines(const std::string& path,
-                                   const std::string& display_name,
-                                   std::vector<int>* line_numbers) {
-  std::ifstream in(path);
-  if (!in) throw InputError(display_name, 0, "cannot open " + path);
-  std::vector<std::string> lines;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    lines.push_back(line);
-    line_numbers->push_back(number);
-  }
-  return lines;
-}
-
 }  // namespace
 
 BalProblem ParseBalProblem(const std::string& text,
@@ -314,8 +296,10 @@ BalProblem ReduceLikeColmap(const BalProblem& problem, int min_track_length,
   return reduced;
 }
 
-void WriteColmapModel(const BalProblem& problem, const std::string& folder) {
-  fs::create_directories(folder);
+ColmapModel ColmapModelOf(const BalProblem& problem) {
+  ColmapModel model;
+  model.camera_notes = {
+      "Converted from a BAL problem by zebrageo (RADIAL: f, cx, cy, k1, k2)"};
   // Index of each observation within its image's POINTS2D list.
   std::vector<std::vector<int>> image_observations(problem.cameras.size());
   std::vector<int> index_in_image(problem.observations.size());
@@ -324,172 +308,89 @@ void WriteColmapModel(const BalProblem& problem, const std::string& folder) {
     index_in_image[i] = static_cast<int>(list.size());
     list.push_back(static_cast<int>(i));
   }
-  std::vector<Eigen::Vector2d> principal(problem.cameras.size());
   for (int c = 0; c < problem.num_cameras(); ++c) {
-    principal[c] = ExportPrincipalPoint(problem, c);
+    const auto& camera = problem.cameras[c];
+    const Eigen::Vector2d principal = ExportPrincipalPoint(problem, c);
+    model.cameras.push_back(
+        {c + 1,
+         "RADIAL",
+         static_cast<int>(2 * principal.x()),
+         static_cast<int>(2 * principal.y()),
+         {camera[6], principal.x(), principal.y(), camera[7], camera[8]}});
+    Eigen::Matrix3d R_bal;
+    ceres::AngleAxisToRotationMatrix(
+        camera.data(), ceres::ColumnMajorAdapter3x3(R_bal.data()));
+    ColmapImage image;
+    image.id = c + 1;
+    image.q = Eigen::Quaterniond(FlipYZ() * R_bal);
+    image.t = FlipYZ() * Eigen::Vector3d(camera[3], camera[4], camera[5]);
+    image.camera_id = c + 1;
+    image.name = "camera" + std::to_string(c) + ".jpg";
+    for (int i : image_observations[c]) {
+      const BalObservation& o = problem.observations[i];
+      image.points2d.emplace_back(
+          Eigen::Vector2d(o.xy.x() + principal.x(), -o.xy.y() + principal.y()),
+          o.point + 1);
+    }
+    model.images.push_back(std::move(image));
   }
-
-  WriteFileAtomically(folder + "/cameras.txt", [&](std::ostream& out) {
-    out << "# Camera list with one line of data per camera:\n"
-           "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
-           "# Converted from a BAL problem by zebrageo (RADIAL: f, cx, cy, "
-           "k1, k2)\n";
-    for (int c = 0; c < problem.num_cameras(); ++c) {
-      const auto& camera = problem.cameras[c];
-      out << c + 1 << " RADIAL " << static_cast<int>(2 * principal[c].x())
-          << " " << static_cast<int>(2 * principal[c].y()) << " "
-          << FormatDouble(camera[6]) << " " << FormatDouble(principal[c].x())
-          << " " << FormatDouble(principal[c].y()) << " "
-          << FormatDouble(camera[7]) << " " << FormatDouble(camera[8]) << "\n";
-    }
-  });
-  WriteFileAtomically(folder + "/images.txt", [&](std::ostream& out) {
-    out << "# Image list with two lines of data per image:\n"
-           "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
-           "#   POINTS2D[] as (X, Y, POINT3D_ID)\n";
-    for (int c = 0; c < problem.num_cameras(); ++c) {
-      const auto& camera = problem.cameras[c];
-      Eigen::Matrix3d R_bal;
-      ceres::AngleAxisToRotationMatrix(
-          camera.data(), ceres::ColumnMajorAdapter3x3(R_bal.data()));
-      const Eigen::Quaterniond q(FlipYZ() * R_bal);
-      const Eigen::Vector3d t =
-          FlipYZ() * Eigen::Vector3d(camera[3], camera[4], camera[5]);
-      out << c + 1 << " " << FormatDouble(q.w()) << " " << FormatDouble(q.x())
-          << " " << FormatDouble(q.y()) << " " << FormatDouble(q.z()) << " "
-          << FormatDouble(t.x()) << " " << FormatDouble(t.y()) << " "
-          << FormatDouble(t.z()) << " " << c + 1 << " camera" << c << ".jpg\n";
-      bool first = true;
-      for (int i : image_observations[c]) {
-        const BalObservation& o = problem.observations[i];
-        out << (first ? "" : " ") << FormatDouble(o.xy.x() + principal[c].x())
-            << " " << FormatDouble(-o.xy.y() + principal[c].y()) << " "
-            << o.point + 1;
-        first = false;
-      }
-      out << "\n";
-    }
-  });
   std::vector<std::vector<int>> point_observations(problem.points.size());
   for (size_t i = 0; i < problem.observations.size(); ++i) {
     point_observations[problem.observations[i].point].push_back(
         static_cast<int>(i));
   }
-  WriteFileAtomically(folder + "/points3D.txt", [&](std::ostream& out) {
-    out << "# 3D point list with one line of data per point:\n"
-           "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, "
-           "POINT2D_IDX)\n";
-    for (int p = 0; p < problem.num_points(); ++p) {
-      const Eigen::Vector3d& X = problem.points[p];
-      out << p + 1 << " " << FormatDouble(X.x()) << " " << FormatDouble(X.y())
-          << " " << FormatDouble(X.z()) << " 128 128 128 0";
-      for (int i : point_observations[p]) {
-        out << " " << problem.observations[i].camera + 1 << " "
-            << index_in_image[i];
-      }
-      out << "\n";
+  for (int p = 0; p < problem.num_points(); ++p) {
+    ColmapPoint3D point;
+    point.id = p + 1;
+    point.X = problem.points[p];
+    point.rgb = {128, 128, 128};
+    for (int i : point_observations[p]) {
+      point.track.emplace_back(problem.observations[i].camera + 1,
+                               index_in_image[i]);
     }
-  });
+    model.points.push_back(std::move(point));
+  }
+  return model;
 }
 
-BalProblem ReadColmapModel(const std::string& folder) {
+BalProblem BalProblemOf(const ColmapModel& model) {
   BalProblem problem;
   std::map<int64_t, int> camera_index;  // COLMAP camera id -> BAL camera
   std::map<int64_t, Eigen::Vector2d> principal;
-  {
-    std::vector<int> numbers;
-    const std::vector<std::string> lines =
-        DataLines(folder + "/cameras.txt", "cameras.txt", &numbers);
-    for (size_t i = 0; i < lines.size(); ++i) {
-      std::istringstream in(lines[i]);
-      int64_t id = 0;
-      std::string model;
-      int width = 0, height = 0;
-      double f = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
-      if (!(in >> id >> model >> width >> height >> f >> cx >> cy >> k1 >>
-            k2)) {
-        throw InputError(
-            "cameras.txt", numbers[i],
-            "expected CAMERA_ID RADIAL WIDTH HEIGHT f cx cy k1 k2");
-      }
-      if (model != "RADIAL") {
-        throw InputError("cameras.txt", numbers[i],
-                         "camera model " + model + " is not RADIAL");
-      }
-      camera_index[id] = static_cast<int>(problem.cameras.size());
-      principal[id] = Eigen::Vector2d(cx, cy);
-      problem.cameras.push_back({0, 0, 0, 0, 0, 0, f, k1, k2});
+  for (const ColmapCamera& camera : model.cameras) {
+    if (camera.model != "RADIAL" || camera.params.size() != 5) {
+      throw InputError("cameras.txt", 0,
+                       "camera " + std::to_string(camera.id) + ": model " +
+                           camera.model + " is not RADIAL (f cx cy k1 k2)");
     }
+    camera_index[camera.id] = static_cast<int>(problem.cameras.size());
+    principal[camera.id] = Eigen::Vector2d(camera.params[1], camera.params[2]);
+    problem.cameras.push_back({0, 0, 0, 0, 0, 0, camera.params[0],
+                               camera.params[3], camera.params[4]});
   }
   std::map<int64_t, int> point_index;
-  {
-    std::vector<int> numbers;
-    const std::vector<std::string> lines =
-        DataLines(folder + "/points3D.txt", "points3D.txt", &numbers);
-    for (size_t i = 0; i < lines.size(); ++i) {
-      std::istringstream in(lines[i]);
-      int64_t id = 0;
-      Eigen::Vector3d X;
-      if (!(in >> id >> X.x() >> X.y() >> X.z())) {
-        throw InputError("points3D.txt", numbers[i], "expected ID X Y Z");
-      }
-      point_index[id] = static_cast<int>(problem.points.size());
-      problem.points.push_back(X);
-    }
+  for (const ColmapPoint3D& point : model.points) {
+    point_index[point.id] = static_cast<int>(problem.points.size());
+    problem.points.push_back(point.X);
   }
-  std::vector<int> numbers;
-  const std::vector<std::string> lines =
-      DataLines(folder + "/images.txt", "images.txt", &numbers);
-  // Images have two lines, but COLMAP writes an empty POINTS2D line for an
-  // image without points, which DataLines skips: read pose lines by shape.
-  for (size_t i = 0; i < lines.size(); ++i) {
-    std::istringstream in(lines[i]);
-    int64_t image_id = 0, camera_id = 0;
-    double qw, qx, qy, qz;
-    Eigen::Vector3d t;
-    std::string name;
-    if (!(in >> image_id >> qw >> qx >> qy >> qz >> t.x() >> t.y() >> t.z() >>
-          camera_id >> name)) {
-      throw InputError("images.txt", numbers[i],
-                       "expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME");
-    }
-    const auto camera = camera_index.find(camera_id);
-    if (camera == camera_index.end()) {
-      throw InputError("images.txt", numbers[i],
-                       "unknown camera " + std::to_string(camera_id));
-    }
-    auto& params = problem.cameras[camera->second];
+  for (const ColmapImage& image : model.images) {
+    const int camera = camera_index.at(image.camera_id);
+    auto& params = problem.cameras[camera];
     const Eigen::Matrix3d R_bal =
-        FlipYZ() *
-        Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
+        FlipYZ() * image.q.normalized().toRotationMatrix();
     ceres::RotationMatrixToAngleAxis(ceres::ColumnMajorAdapter3x3(R_bal.data()),
                                      params.data());
-    const Eigen::Vector3d t_bal = FlipYZ() * t;
+    const Eigen::Vector3d t_bal = FlipYZ() * image.t;
     params[3] = t_bal.x();
     params[4] = t_bal.y();
     params[5] = t_bal.z();
-    // The POINTS2D line follows unless the next line is another image.
-    if (i + 1 >= lines.size()) break;
-    std::istringstream points(lines[i + 1]);
-    std::vector<double> values;
-    double value = 0.0;
-    while (points >> value) values.push_back(value);
-    // A pose line ends with a name, so it does not read as numbers only.
-    if (!points.eof() || values.size() % 3 != 0 || values.empty()) continue;
-    ++i;
-    const Eigen::Vector2d& c = principal[camera_id];
-    for (size_t k = 0; k < values.size(); k += 3) {
-      const int64_t point_id = static_cast<int64_t>(values[k + 2]);
+    const Eigen::Vector2d& c = principal[image.camera_id];
+    for (const auto& [xy, point_id] : image.points2d) {
       if (point_id < 0) continue;
-      const auto point = point_index.find(point_id);
-      if (point == point_index.end()) {
-        throw InputError("images.txt", numbers[i],
-                         "unknown 3D point " + std::to_string(point_id));
-      }
       BalObservation o;
-      o.camera = camera->second;
-      o.point = point->second;
-      o.xy = Eigen::Vector2d(values[k] - c.x(), -(values[k + 1] - c.y()));
+      o.camera = camera;
+      o.point = point_index.at(point_id);
+      o.xy = Eigen::Vector2d(xy.x() - c.x(), -(xy.y() - c.y()));
       problem.observations.push_back(o);
     }
   }

@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "survey/colmap_model.h"
+
 namespace zebrageo {
 
 constexpr int kBalCameraSize = 9;
@@ -77,19 +79,18 @@ struct BalReduction {
 BalProblem ReduceLikeColmap(const BalProblem& problem, int min_track_length,
                             BalReduction* reduction);
 
-// Writes `problem` as a COLMAP text model (cameras.txt, images.txt,
-// points3D.txt) in `folder` (created if needed), converted exactly: one
-// RADIAL camera (f, cx, cy, k1, k2) per BAL camera, rotation flipped to
-// COLMAP's +z viewing direction (R_colmap = diag(1,-1,-1) R_bal), image
-// coordinates shifted by (cx, cy) with y mirrored. Each residual, hence the
-// cost, is the same as in BAL as long as the principal point is held fixed
-// (COLMAP's default). Throws std::runtime_error if a file cannot be written.
-void WriteColmapModel(const BalProblem& problem, const std::string& folder);
-// Reads a COLMAP text model written by WriteColmapModel (or by COLMAP from
-// it, e.g. after `colmap bundle_adjuster` and `colmap model_converter
-// --output_type TXT`) back into a BAL problem, inverting the conversion.
-// Throws InputError on malformed files or a camera model other than RADIAL.
-BalProblem ReadColmapModel(const std::string& folder);
+// `problem` as a COLMAP text model (geodata/colmap_export.h writes it),
+// converted exactly: one RADIAL camera (f, cx, cy, k1, k2) per BAL camera,
+// rotation flipped to COLMAP's +z viewing direction (R_colmap =
+// diag(1,-1,-1) R_bal), image coordinates shifted by (cx, cy) with y
+// mirrored. Each residual, hence the cost, is the same as in BAL as long as
+// the principal point is held fixed (COLMAP's default).
+ColmapModel ColmapModelOf(const BalProblem& problem);
+// A COLMAP model made by ColmapModelOf (or by COLMAP from it, e.g. after
+// `colmap bundle_adjuster` and `colmap model_converter --output_type TXT`)
+// back into a BAL problem, inverting the conversion. Throws InputError for
+// a camera model other than RADIAL.
+BalProblem BalProblemOf(const ColmapModel& model);
 
 }  // namespace zebrageo
 

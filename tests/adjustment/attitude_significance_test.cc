@@ -80,7 +80,7 @@ TEST(AttitudeSignificance, ZeroDisablesTheTest) {
   options.num_exposures = 40;
   const Fixture f(options);
   AdjustmentOptions adjustment;
-  adjustment.attitude_significance = 0.0;
+  adjustment.model.attitude_significance = 0.0;
   const AdjustmentResult result = AdjustTrajectory(adjustment, f.Input());
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   EXPECT_EQ(result.summary.attitude_held, Eigen::Vector3i::Zero());
@@ -91,10 +91,8 @@ TEST(AttitudeSignificance, ZeroDisablesTheTest) {
 
 TEST(AttitudeSignificance, NegativeThresholdIsRejectedByCheck) {
   AdjustmentOptions options;
-  options.attitude_significance = -1.0;
-  EXPECT_EQ(options.Check(),
-            "attitude_significance = -1: must be finite and >= 0 (0 "
-            "disables)");
+  options.model.attitude_significance = -1.0;
+  EXPECT_EQ(options.Check(), "model.attitude_significance = -1: must be >= 0");
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "adjustment/bal/bal_adjuster.h"
 #include "adjustment/bal/snavely_reprojection_error.h"
+#include "geodata/colmap_export.h"
 #include "survey/input_error.h"
 #include "tests/survey/test_util.h"
 
@@ -183,8 +184,8 @@ TEST(BalProblem, ColmapModelRoundTripKeepsEveryResidual) {
   const BalProblem problem =
       ReadBalProblem(BalFile("gtsam/dubrovnik-3-7-pre.txt"));
   TemporaryFolder folder;
-  WriteColmapModel(problem, folder.Path("model"));
-  const BalProblem back = ReadColmapModel(folder.Path("model"));
+  WriteColmapModel(ColmapModelOf(problem), folder.Path("model"));
+  const BalProblem back = BalProblemOf(ReadColmapModel(folder.Path("model")));
   ASSERT_EQ(back.num_observations(), problem.num_observations());
   EXPECT_NEAR(BalCost(back), BalCost(problem), 1e-9 * BalCost(problem));
   // Residual by residual: the model lists observations image by image.

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "adjustment/adjustment_options.h"
+
 namespace zebrageo {
 namespace {
 
@@ -172,7 +174,11 @@ TEST(ControlGuard, OffWithZeroSigmas) {
                         options);
   EXPECT_FALSE(guard.Fired());
   options.guard_sigmas = -1.0;
-  EXPECT_NE(options.Check().find("never_worse.guard_sigmas"),
+  EXPECT_NE(options.Check().find("guard_sigmas"), std::string::npos);
+  // Within the adjustment's options the problem is named by its path.
+  AdjustmentOptions adjustment;
+  adjustment.never_worse = options;
+  EXPECT_NE(adjustment.Check().find("never_worse.guard_sigmas"),
             std::string::npos);
 }
 

@@ -64,7 +64,8 @@ std::vector<CrossingVerdict> Select(
   }
   return SelectConsistentCrossings(
       crossings, names, PositionFitOptions(options),
-      options.crossing_consistency_chi_square, two_crossings_sigma_m, dashes);
+      options.selection.crossing_consistency_chi_square, two_crossings_sigma_m,
+      dashes);
 }
 
 int Rejected(const std::vector<CrossingVerdict>& verdicts) {
@@ -84,7 +85,8 @@ TEST(SelectConsistentCrossings,
       Crossing(3.1, Eigen::Vector3d(0.64, -0.85, -0.06)),
       Crossing(7.5, Eigen::Vector3d(0.03, 0.0, 0.0))};
   EXPECT_EQ(Rejected(Select(
-                crossings, AdjustmentOptions().two_crossings_position_sigma_m)),
+                crossings,
+                AdjustmentOptions().selection.two_crossings_position_sigma_m)),
             0);
   // Without the floor, the one-crossing fit rejects one of them: the test
   // above is not passed by a lax threshold.
@@ -97,8 +99,8 @@ TEST(SelectConsistentCrossings, TwoCrossingsStillRejectAJumpNoDriftExplains) {
   const std::vector<CrossingDiscrepancy> crossings = {
       Crossing(3.0, Eigen::Vector3d(0.1, 0.2, 0.0)),
       Crossing(4.0, Eigen::Vector3d(0.1, 4.2, 0.0))};
-  const std::vector<CrossingVerdict> verdicts =
-      Select(crossings, AdjustmentOptions().two_crossings_position_sigma_m);
+  const std::vector<CrossingVerdict> verdicts = Select(
+      crossings, AdjustmentOptions().selection.two_crossings_position_sigma_m);
   EXPECT_EQ(Rejected(verdicts), 1);
 }
 
@@ -110,7 +112,8 @@ TEST(SelectConsistentCrossings, WithThreeTheRepaintedOneIsOut) {
       Crossing(0.0, Eigen::Vector3d(0.1, 0.1, 0.02)),
       Crossing(8.0, Eigen::Vector3d(0.1, 0.7, 0.0)),
       Crossing(16.0, Eigen::Vector3d(0.12, 0.08, 0.01))};
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   const std::vector<CrossingVerdict> verdicts = Select(crossings, floor_m);
   ASSERT_EQ(verdicts.size(), 3u);
   EXPECT_TRUE(verdicts[0].consistent);
@@ -132,7 +135,8 @@ TEST(SelectConsistentCrossings, ACrossingBeyondTheOthersGetsTheFloor) {
       Crossing(27.0, Eigen::Vector3d(0.01, 0.03, 0.09)),
       Crossing(31.0, Eigen::Vector3d(0.07, 0.09, 0.10))};
   EXPECT_EQ(Rejected(Select(
-                crossings, AdjustmentOptions().two_crossings_position_sigma_m)),
+                crossings,
+                AdjustmentOptions().selection.two_crossings_position_sigma_m)),
             0);
   EXPECT_EQ(Rejected(Select(crossings, 0.0)), 1);
 }
@@ -148,7 +152,8 @@ TEST(SelectConsistentCrossings, DashesOnBothSidesFindTheRepaintedOfTwo) {
       Crossing(12.0, Eigen::Vector3d(-0.64, 0.05, 0.0))};
   const std::vector<CrossingDiscrepancy> dashes = {
       Dash(1.5, -0.10), Dash(2.7, -0.11), Dash(15.2, -0.05)};
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   const std::vector<CrossingVerdict> verdicts =
       Select(crossings, floor_m, dashes);
   ASSERT_EQ(verdicts.size(), 2u);
@@ -167,7 +172,8 @@ TEST(SelectConsistentCrossings, DashesKeepTwoCrossingsADriftSeparates) {
   const std::vector<CrossingDiscrepancy> crossings = {
       Crossing(3.1, Eigen::Vector3d(0.64, -0.85, -0.06)),
       Crossing(7.5, Eigen::Vector3d(0.03, 0.0, 0.0))};
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   EXPECT_EQ(
       Rejected(Select(crossings, floor_m,
                       {Dash(7.0, 0.04), Dash(8.2, 0.02), Dash(9.0, 0.03)})),
@@ -184,7 +190,8 @@ TEST(SelectConsistentCrossings, DashesKeepTwoCrossingsADriftSeparates) {
 // track. Alone, a crossing was never tested: it was control, and H went
 // 12.6 -> 27.1 cm. The lines test it on the axis they measure.
 TEST(SelectConsistentCrossings, RoadLinesOnBothSidesTestALoneCrossing) {
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   const std::vector<CrossingDiscrepancy> lines = {
       Lines(2.0, 0.01),  Lines(4.0, -0.02), Lines(6.0, 0.0),
       Lines(10.0, 0.02), Lines(12.0, 0.01), Lines(14.0, -0.01)};
@@ -209,7 +216,8 @@ TEST(SelectConsistentCrossings, RoadLinesOnBothSidesTestALoneCrossing) {
 // the lines' cross-track (chi-square 14.0), was control and H went 63.5 ->
 // 70.8 cm.
 TEST(SelectConsistentCrossings, ALoneCrossingIsJudgedOnTheAxesTested) {
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   const std::vector<CrossingDiscrepancy> lines = {
       Lines(2.0, 0.0),  Lines(4.0, 0.0),  Lines(6.0, 0.0),
       Lines(10.0, 0.0), Lines(12.0, 0.0), Lines(14.0, 0.0)};
@@ -232,7 +240,8 @@ TEST(SelectConsistentCrossings, ALoneCrossingIsJudgedOnTheAxesTested) {
 // cm; here 0.45 m). A dash is one mark matched alone: a lone crossing is
 // judged by the lines across the track only.
 TEST(SelectConsistentCrossings, DashesDoNotJudgeALoneCrossing) {
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   const std::vector<CrossingDiscrepancy> witnesses = {
       Dash(3.0, 1.0),     Dash(5.0, 1.0),    Dash(11.0, 1.0),
       Dash(13.0, 1.0),    Lines(2.0, -0.15), Lines(6.0, -0.16),
@@ -246,7 +255,8 @@ TEST(SelectConsistentCrossings, DashesDoNotJudgeALoneCrossing) {
 // the crossing (a multipath switch between them): the floor holds, and a
 // lone crossing 0.3 m from them across the track is kept.
 TEST(SelectConsistentCrossings, RoadLinesOnOneSideKeepALoneCrossing) {
-  const double floor_m = AdjustmentOptions().two_crossings_position_sigma_m;
+  const double floor_m =
+      AdjustmentOptions().selection.two_crossings_position_sigma_m;
   const std::vector<CrossingDiscrepancy> lines = {
       Lines(2.0, 0.01), Lines(4.0, -0.02), Lines(6.0, 0.0)};
   EXPECT_EQ(Rejected(Select({Crossing(10.0, Eigen::Vector3d(0.58, -0.29, 0.0))},

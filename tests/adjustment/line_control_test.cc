@@ -1,10 +1,10 @@
-#include "adjustment/line_control.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <memory>
+
+#include "adjustment/line_costs.h"
 
 namespace zebrageo {
 namespace {

@@ -171,7 +171,7 @@ TEST_F(LineOnlyAdjustment, ACrossingRejectedLeavesTheLinesAloneAsWithout) {
 
 TEST_F(LineOnlyAdjustment, CanBeTurnedOff) {
   AdjustmentOptions options;
-  options.line_control_without_crossings = false;
+  options.road_lines.line_control_without_crossings = false;
   const AdjustmentResult result = Adjust(options);
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   EXPECT_FALSE(result.summary.corrected);
@@ -184,10 +184,10 @@ TEST_F(LineOnlyAdjustment, CanBeTurnedOff) {
 
 TEST(LineOnlyAdjustmentOptions, CheckNamesTheBadValue) {
   AdjustmentOptions options;
-  options.line_discrepancy_bin_s = 0.0;
+  options.road_lines.line_discrepancy_bin_s = 0.0;
   EXPECT_NE(options.Check().find("line_discrepancy_bin_s"), std::string::npos);
   options = AdjustmentOptions();
-  options.line_discrepancy_min_points = 0;
+  options.road_lines.line_discrepancy_min_points = 0;
   EXPECT_NE(options.Check().find("line_discrepancy_min_points"),
             std::string::npos);
 }

@@ -141,7 +141,7 @@ TEST_F(OutageModel, TheJumpIsReadAsTheOutagesDriftAndItsCrossingsKept) {
   const PoseErrors before = ScorePoses(o.survey, InputCameraPoses(o.survey));
   ASSERT_GT(before.max_horizontal_m, 2.5);
   AdjustmentOptions options;
-  options.check_crossing_share = 0.0;
+  options.control.check_crossing_share = 0.0;
   const AdjustmentResult result = AdjustTrajectory(options, o.Input());
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   EXPECT_TRUE(Rejected(result, o.inside).empty());

@@ -109,7 +109,8 @@ TEST(SolverOptions, CheckNamesTheFieldTheValueAndTheRule) {
       {[](SolverOptions* o, double v) {
          o->max_sparse_pose_blocks = static_cast<int>(v);
        },
-       49, "max_sparse_pose_blocks = 49: must be >= max_dense_pose_blocks"},
+       49,
+       "max_sparse_pose_blocks = 49: must be >= max_dense_pose_blocks (50)"},
       {[](SolverOptions* o, double v) { o->num_threads = static_cast<int>(v); },
        0, "num_threads = 0: must be >= 1"},
       {[](SolverOptions* o, double v) {

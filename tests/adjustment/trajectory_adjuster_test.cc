@@ -7,7 +7,6 @@
 #include <iostream>
 #include <set>
 
-#include "adjustment/adjustment_io.h"
 #include "survey/input_error.h"
 #include "tests/adjustment/pose_errors.h"
 #include "tests/support/synthetic_survey.h"
@@ -103,7 +102,7 @@ TEST(TrajectoryAdjuster, CheckPointsAreHeldOutAndMeasureAnHonestAccuracy) {
 TEST(TrajectoryAdjuster, NoCheckCrossingMeansNoCheckFigure) {
   const Fixture f = MakeFixture(KilometreOptions());
   AdjustmentOptions options;
-  options.check_crossing_share = 0.0;
+  options.control.check_crossing_share = 0.0;
   const AdjustmentResult result = AdjustTrajectory(options, f.Input());
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   EXPECT_EQ(result.summary.num_check_crossings, 0);
@@ -130,7 +129,8 @@ TEST(TrajectoryAdjuster, WrongControlPointsAreFlaggedAndRemoved) {
     }
   }
   AdjustmentOptions options;
-  options.check_crossing_share = 0.0;  // every crossing in the adjustment
+  options.control.check_crossing_share =
+      0.0;  // every crossing in the adjustment
   const AdjustmentResult result = AdjustTrajectory(options, f.Input());
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   int rejected_x9 = 0, total_x9 = 0, rejected_other = 0;
@@ -142,7 +142,7 @@ TEST(TrajectoryAdjuster, WrongControlPointsAreFlaggedAndRemoved) {
       rejected_x9 += rejected;
     } else if (p.crossing_id == "X4" && p.band == 2 && p.db_vertex == 1) {
       blunder_rejected = rejected;
-      EXPECT_GT(p.normalized_residual, options.blunder_threshold);
+      EXPECT_GT(p.normalized_residual, options.blunders.blunder_threshold);
     } else {
       rejected_other += rejected;
     }
@@ -172,7 +172,7 @@ TEST(TrajectoryAdjuster, DatabaseErrorLargerThanTheDriftDoesNotMakeItWorse) {
   options.database_offset_m = 0.07;
   const Fixture f = MakeFixture(options);
   AdjustmentOptions adjustment;
-  adjustment.check_crossing_share = 0.0;
+  adjustment.control.check_crossing_share = 0.0;
   const AdjustmentResult result = AdjustTrajectory(adjustment, f.Input());
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   const PoseErrors before = ScorePoses(f.survey, InputCameraPoses(f.survey));
@@ -186,7 +186,7 @@ TEST(TrajectoryAdjuster, DatabaseErrorLargerThanTheDriftDoesNotMakeItWorse) {
 
   // Believing the GNSS/INS no better than 1 m follows the database instead:
   // the test above can fail.
-  adjustment.estimate_position_model = false;
+  adjustment.model.estimate_position_model = false;
   const AdjustmentResult blind = AdjustTrajectory(adjustment, f.Input());
   ASSERT_TRUE(blind.summary.IsUsable()) << blind.summary.message;
   const PoseErrors followed = ScorePoses(f.survey, blind.camera_poses);
@@ -199,9 +199,9 @@ TEST(TrajectoryAdjuster, CheckCrossingsAreControlInTheFinalAdjustment) {
   const Fixture f = MakeFixture(KilometreOptions());
   AdjustmentOptions options;
   const AdjustmentResult final_result = AdjustTrajectory(options, f.Input());
-  options.check_points_in_final = false;
+  options.control.check_points_in_final = false;
   const AdjustmentResult held_out = AdjustTrajectory(options, f.Input());
-  options.check_crossing_share = 0.0;
+  options.control.check_crossing_share = 0.0;
   const AdjustmentResult all = AdjustTrajectory(options, f.Input());
   ASSERT_TRUE(final_result.summary.IsUsable());
   ASSERT_TRUE(held_out.summary.IsUsable());
@@ -226,8 +226,8 @@ TEST(TrajectoryAdjuster, SelfCalibrationRecoversALeverArmError) {
   f.survey.rig.cameras[0].T_body_cam.translation() +=
       Eigen::Vector3d(0.0, 0.04, 0.0);
   AdjustmentOptions options;
-  options.self_calibrate_rig = true;
-  options.lever_arm_sigma_m = 0.05;
+  options.rig_calibration.self_calibrate_rig = true;
+  options.rig_calibration.lever_arm_sigma_m = 0.05;
   const AdjustmentResult result = AdjustTrajectory(options, f.Input());
   ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
   ASSERT_EQ(result.T_body_cam.size(), 2u);
@@ -246,9 +246,9 @@ TEST(TrajectoryAdjuster, VehicleMotionHoldsTheHeadingBetweenCrossings) {
   // (attitude_significance_test.cc) holds this heading correction, at 1.7
   // posterior sd, at the input's.
   AdjustmentOptions with;
-  with.attitude_significance = 0.0;
+  with.model.attitude_significance = 0.0;
   AdjustmentOptions without = with;
-  without.sideslip_sigma_rad = 0.0;
+  without.vehicle_motion.sideslip_sigma_rad = 0.0;
   const AdjustmentResult a = AdjustTrajectory(without, f.Input());
   const AdjustmentResult b = AdjustTrajectory(with, f.Input());
   ASSERT_TRUE(a.summary.IsUsable()) << a.summary.message;
@@ -361,7 +361,7 @@ TEST(TrajectoryAdjuster, WithoutControlReturnsTheInputTrajectoryAndWarns) {
 TEST(TrajectoryAdjuster, InvalidOptionsGiveAnUnusableSummaryNamingTheField) {
   const Fixture f = MakeFixture(KilometreOptions());
   AdjustmentOptions options;
-  options.knot_spacing_s = -1.0;
+  options.model.knot_spacing_s = -1.0;
   const AdjustmentResult result = AdjustTrajectory(options, f.Input());
   EXPECT_FALSE(result.summary.IsUsable());
   EXPECT_NE(result.summary.message.find("knot_spacing_s = -1"),
@@ -372,68 +372,15 @@ TEST(TrajectoryAdjuster, InvalidOptionsGiveAnUnusableSummaryNamingTheField) {
 TEST(AdjustmentOptions, CheckNamesFieldValueAndConstraint) {
   AdjustmentOptions options;
   EXPECT_EQ(options.Check(), "");
-  options.check_crossing_share = 1.0;
-  EXPECT_EQ(options.Check(), "check_crossing_share = 1: must be in [0, 1)");
+  options.control.check_crossing_share = 1.0;
+  EXPECT_EQ(options.Check(),
+            "control.check_crossing_share = 1: must be in [0, 1)");
   options = AdjustmentOptions();
   options.solver.num_threads = 0;
   EXPECT_EQ(options.Check(), "solver.num_threads = 0: must be >= 1");
   options = AdjustmentOptions();
-  options.vertex_sigma_px = 0.0;
-  EXPECT_EQ(options.Check(), "vertex_sigma_px = 0: must be finite and > 0");
-}
-
-TEST(AdjustmentIo, WritesEveryContractOutputReadableByTheSurveyReaders) {
-  SyntheticSurveyOptions options = KilometreOptions();
-  options.num_exposures = 120;
-  const SyntheticSurvey survey = MakeSyntheticSurvey(options);
-  TemporaryFolder folder;
-  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
-  const AdjustmentData data =
-      LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
-  EXPECT_EQ(data.missing_images,
-            static_cast<int>(survey.exposures.images.size()));
-  const AdjustmentOptions adjustment_options;
-  const AdjustmentResult result =
-      AdjustTrajectory(adjustment_options, data.Input());
-  ASSERT_TRUE(result.summary.IsUsable()) << result.summary.message;
-  WriteAdjustmentResults(data, adjustment_options, result, nullptr,
-                         folder.Path("results"));
-  const auto poses =
-      ReadCameraPoses(folder.Path("results/poses.csv"), "poses.csv");
-  EXPECT_EQ(poses.size(), survey.exposures.images.size());
-  const auto samples = ReadTrajectorySamples(
-      folder.Path("results/trajectory_corrected.csv"), "trajectory_corrected");
-  ASSERT_EQ(samples.size(), survey.measured_samples.size());
-  for (size_t i = 0; i < samples.size(); ++i) {
-    ASSERT_EQ(samples[i].time, survey.measured_samples[i].time);
-  }
-  const auto gcps = ReadGcpResiduals(folder.Path("results/gcp_residuals.csv"),
-                                     "gcp_residuals.csv");
-  EXPECT_EQ(gcps.size(), result.control_points.size());
-  EXPECT_FALSE(
-      ReadAdjustedBands(folder.Path("results/bands.geojson"), "bands.geojson")
-          .empty());
-  for (const char* name :
-       {"adjustment.json", "report.json", "colmap/cameras.txt",
-        "colmap/images.txt", "colmap/points3D.txt"}) {
-    EXPECT_TRUE(std::filesystem::is_regular_file(
-        folder.Path(std::string("results/") + name)))
-        << name;
-  }
-}
-
-TEST(AdjustmentIo, MissingStageOutputsNameTheStageToRun) {
-  const SyntheticSurvey survey = MakeSyntheticSurvey(KilometreOptions());
-  TemporaryFolder folder;
-  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
-  std::filesystem::remove(folder.Path("results/matches.csv"));
-  try {
-    LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
-    FAIL() << "expected an InputError";
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("zebrageo match"),
-              std::string::npos);
-  }
+  options.control.vertex_sigma_px = 0.0;
+  EXPECT_EQ(options.Check(), "control.vertex_sigma_px = 0: must be > 0");
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// MatchLinesForAdjustment against a simulated survey's truth: a vehicle
+// The road lines registered to the database (registration/
+// line_registration.h) against a simulated survey's truth: a vehicle
 // driving east between painted lane lines, the reconstructed line points
 // exactly where the true trajectory puts them, one database line drawn
 // 25 cm away from its paint (repainted).
@@ -10,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/stages.h"
+#include "pipeline/adjustment_pass.h"
+#include "registration/line_registration.h"
 #include "survey/results_lines.h"
 #include "tests/survey/test_util.h"
 
@@ -18,6 +20,33 @@ namespace zebrageo {
 namespace {
 
 using ::testing::HasSubstr;
+
+// The registration on `zebra`'s trajectory, its files written into
+// `folder` as the adjust stage writes them (nothing when it is "").
+std::vector<LineControlPoint> MatchLinesForAdjustment(
+    const AdjustmentData& data, const AdjustmentOptions& options,
+    const LineRegistrationOptions& registration, const AdjustmentResult& zebra,
+    const std::vector<ReconstructedLinePoint>* points,
+    const std::string& folder, std::vector<std::string>* warnings) {
+  if (points == nullptr) return {};
+  LineRegistrationInput input;
+  input.roadmarks = &data.roadmarks;
+  input.frame = &data.frame;
+  input.exposures = &data.exposures;
+  input.vertices = &data.vertices;
+  input.matches = &data.matches;
+  input.trajectory = {&zebra.corrected_samples, &zebra.corrected_poses,
+                      zebra.summary.corrected};
+  input.min_database_sigma_m = options.control.min_database_sigma_m;
+  LineRegistration lines = RegisterRoadLines(*points, input, registration);
+  warnings->insert(warnings->end(), lines.warnings.begin(),
+                   lines.warnings.end());
+  if (!folder.empty() && lines.record) {
+    WriteLineMatches(lines.rows, folder + "/" + kLineMatchesFile);
+    WriteLineControl(*lines.record, folder + "/" + kLineControlFile);
+  }
+  return lines.control;
+}
 
 constexpr double kSpeedMps = 10.0;
 constexpr double kCameraHeightM = 2.0;
@@ -107,8 +136,9 @@ class MatchLinesForAdjustmentTest : public ::testing::Test {
 
 TEST_F(MatchLinesForAdjustmentTest, ControlLiesOnThePaintAndTheStaleLineIsOut) {
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
+                              folder_.Path(), &warnings);
 
   // Nearly every point of the three true lines is control (the database
   // lines are long enough for all of them).
@@ -153,8 +183,9 @@ TEST_F(MatchLinesForAdjustmentTest, WithoutZebraControlTheLinesFindTheOffset) {
   zebra_.summary.corrected = false;
   for (Pose& pose : zebra_.corrected_poses) pose.p_enu.y() -= 1.6;
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
+                              folder_.Path(), &warnings);
   EXPECT_GE(static_cast<int>(control.size()), 3 * points_per_line_ * 8 / 10);
   for (const LineControlPoint& c : control) {
     const Eigen::Vector3d p_enu = TruePose(c.time).T_enu_body() * c.p_body;
@@ -219,8 +250,9 @@ TEST_F(MatchLinesForAdjustmentTest, WholeDashesControlTheAlongTrackPosition) {
   const int whole = AddDashes(&data_, &points_, 5.25 + 3.5);
   ASSERT_GT(whole, 20);
   std::vector<std::string> warnings;
-  const std::vector<LineControlPoint> control = MatchLinesForAdjustment(
-      data_, AdjustmentOptions(), zebra_, &points_, folder_.Path(), &warnings);
+  const std::vector<LineControlPoint> control =
+      MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
+                              folder_.Path(), &warnings);
   int along = 0;
   for (const LineControlPoint& c : control) {
     if (!c.along_track) continue;
@@ -261,14 +293,14 @@ TEST_F(MatchLinesForAdjustmentTest, NoDashOutsideTheAlongTrackGate) {
   for (Pose& pose : zebra_.corrected_poses) pose.p_enu.x() -= 0.5;
   std::vector<std::string> warnings;
   for (const LineControlPoint& c :
-       MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_, &points_,
+       MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
                                folder_.Path(), &warnings)) {
     EXPECT_FALSE(c.along_track);
   }
   zebra_.summary.corrected = false;
   for (Pose& pose : zebra_.corrected_poses) pose.p_enu.x() += 0.5;
   for (const LineControlPoint& c :
-       MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_, &points_,
+       MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_, &points_,
                                folder_.Path(), &warnings)) {
     EXPECT_FALSE(c.along_track);
   }
@@ -287,8 +319,8 @@ TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
     band.sigma_xy_m = 0.05;
     band.sigma_z_m = 0.1;
     const double n0 = 2.0 - b, n1 = n0 + 0.5;
-    const Eigen::Vector3d corners[4] = {{100, n0, 0}, {103, n0, 0},
-                                        {103, n1, 0}, {100, n1, 0}};
+    const Eigen::Vector3d corners[4] = {
+        {100, n0, 0}, {103, n0, 0}, {103, n1, 0}, {100, n1, 0}};
     for (int k = 0; k < 4; ++k) {
       band.corners[k] = data_.frame.GeodeticFromEnu(corners[k]);
     }
@@ -315,7 +347,7 @@ TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
     std::vector<std::string> warnings;
     std::vector<LineControlPoint> along;
     for (const LineControlPoint& c : MatchLinesForAdjustment(
-             data_, AdjustmentOptions(), zebra_, &points, "", &warnings)) {
+             data_, AdjustmentOptions(), {}, zebra_, &points, "", &warnings)) {
       if (c.along_track) along.push_back(c);
     }
     return along;
@@ -343,7 +375,7 @@ TEST_F(MatchLinesForAdjustmentTest, ACrossingsEdgeControlsAlongTheTrack) {
 
 TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
   std::vector<std::string> warnings;
-  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
+  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_,
                                       nullptr, folder_.Path(), &warnings)
                   .empty());
   EXPECT_TRUE(warnings.empty());
@@ -353,7 +385,7 @@ TEST_F(MatchLinesForAdjustmentTest, NothingWithoutReconstructedLines) {
 TEST_F(MatchLinesForAdjustmentTest, ADatabaseWithoutLinesIsAWarning) {
   data_.roadmarks.lines.clear();
   std::vector<std::string> warnings;
-  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), zebra_,
+  EXPECT_TRUE(MatchLinesForAdjustment(data_, AdjustmentOptions(), {}, zebra_,
                                       &points_, folder_.Path(), &warnings)
                   .empty());
   ASSERT_EQ(warnings.size(), 1u);

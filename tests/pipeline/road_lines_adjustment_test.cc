@@ -1,5 +1,5 @@
-// AdjustByRoadLinesAlone (pipeline/stages.h): the trajectory the road lines
-// alone correct, on which the second registration pass searches when the
+// AdjustByRoadLinesAlone (pipeline/adjustment_pass.h): the trajectory the road
+// lines alone correct, on which the second registration pass searches when the
 // adjustment had too few crossings. A synthetic survey drifting by a metre,
 // two lane lines painted along its true path and drawn so in the database,
 // their points reconstructed ideally from the true poses.
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/stages.h"
+#include "pipeline/adjustment_pass.h"
 #include "tests/support/synthetic_survey.h"
 
 namespace zebrageo {
@@ -136,7 +136,7 @@ class RoadLinesAdjustmentTest : public ::testing::Test {
 
 TEST_F(RoadLinesAdjustmentTest, CorrectsAcrossTheTrackAndKeepsAlongIt) {
   const std::optional<RoadLinesAdjustment> lines =
-      AdjustByRoadLinesAlone(data_, &points_, AdjustmentOptions());
+      AdjustByRoadLinesAlone(data_, &points_, AdjustmentOptions(), {});
   ASSERT_TRUE(lines.has_value());
   EXPECT_TRUE(lines->record.usable);
   EXPECT_TRUE(lines->record.road_lines_only);
@@ -153,18 +153,18 @@ TEST_F(RoadLinesAdjustmentTest, CorrectsAcrossTheTrackAndKeepsAlongIt) {
 }
 
 TEST_F(RoadLinesAdjustmentTest, NothingWithoutLinePointsOrWhenTurnedOff) {
-  EXPECT_FALSE(
-      AdjustByRoadLinesAlone(data_, nullptr, AdjustmentOptions()).has_value());
+  EXPECT_FALSE(AdjustByRoadLinesAlone(data_, nullptr, AdjustmentOptions(), {})
+                   .has_value());
   const std::vector<ReconstructedLinePoint> none;
-  EXPECT_FALSE(
-      AdjustByRoadLinesAlone(data_, &none, AdjustmentOptions()).has_value());
+  EXPECT_FALSE(AdjustByRoadLinesAlone(data_, &none, AdjustmentOptions(), {})
+                   .has_value());
   AdjustmentOptions off;
-  off.line_control_without_crossings = false;
-  EXPECT_FALSE(AdjustByRoadLinesAlone(data_, &points_, off).has_value());
+  off.road_lines.line_control_without_crossings = false;
+  EXPECT_FALSE(AdjustByRoadLinesAlone(data_, &points_, off, {}).has_value());
   // A database without lines: nothing to correct with.
   data_.roadmarks.lines.clear();
-  EXPECT_FALSE(
-      AdjustByRoadLinesAlone(data_, &points_, AdjustmentOptions()).has_value());
+  EXPECT_FALSE(AdjustByRoadLinesAlone(data_, &points_, AdjustmentOptions(), {})
+                   .has_value());
 }
 
 }  // namespace

@@ -276,7 +276,7 @@ TEST(LongSides, CheckNamesTheBadField) {
   ZebraSpecification zebra;
   zebra.max_band_length_m = 1.0;
   EXPECT_EQ(zebra.Check(),
-            "max_band_length_m = 1: must be >= min_band_length_m");
+            "max_band_length_m = 1: must be >= min_band_length_m (2.5)");
 }
 
 }  // namespace

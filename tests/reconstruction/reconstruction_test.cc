@@ -347,7 +347,7 @@ TEST(ReconstructionOptions, CheckNamesTheBadNestedField) {
   ReconstructionOptions options;
   EXPECT_EQ(options.Check(), "");
   options.search.slab_half_thickness_m = 0.0;
-  EXPECT_EQ(options.Check(), "slab_half_thickness_m = 0: must be > 0");
+  EXPECT_EQ(options.Check(), "search.slab_half_thickness_m = 0: must be > 0");
   options = ReconstructionOptions();
   options.threads = -2;
   EXPECT_EQ(options.Check(), "threads = -2: must be >= 0");

@@ -103,8 +103,11 @@ TEST_F(ServerApi,
               "/jobs/" + job["id"].get<std::string>());
     ids.push_back(job["id"]);
   }
+  // Options as `zebrageo run --options` reads them (here the defaults,
+  // given: the results must still equal the CLI's).
   const httplib::Result folder_job =
-      FolderJob(client, {{"folder", "surveys/a"}, {"options", json::object()}});
+      FolderJob(client, {{"folder", "surveys/a"},
+                         {"options", {{"lines", true}, {"rematch", true}}}});
   ASSERT_TRUE(folder_job);
   ASSERT_EQ(folder_job->status, 201) << folder_job->body;
   ids.push_back(JsonOf(folder_job)["id"]);
@@ -203,6 +206,20 @@ TEST_F(ServerApi,
        Quote(metrics_file))
           .c_str());
   EXPECT_TRUE(WEXITSTATUS(parsed) == 0 || WEXITSTATUS(parsed) == 77);
+
+  // GET /options: what `zebrageo run --print-options` prints; the folder
+  // job ran with its options file.
+  const std::string printed = folder_->Path("print-options.json");
+  ASSERT_EQ(std::system((Quote(ZEBRAGEO_BINARY) + " run --print-options > " +
+                         Quote(printed))
+                            .c_str()),
+            0);
+  std::ifstream printed_in(printed);
+  EXPECT_EQ(JsonOf(client.Get("/options")), json::parse(printed_in));
+  const json folder_options = json::parse(
+      std::ifstream(folder_->Path("root/jobs/" + ids[2] + "/options.json")),
+      nullptr, false);
+  EXPECT_EQ(folder_options, json({{"lines", true}, {"rematch", true}}));
 
   // The webhooks: each upload's job, once, after a refused first attempt.
   for (int i = 0; i < 100 && hook.bodies().size() < 2; ++i) {

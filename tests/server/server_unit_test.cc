@@ -195,6 +195,30 @@ TEST(RunInvocation, ProgressAndErrorAreReadFromTheRunsFiles) {
   EXPECT_EQ(LogTail(files.Log(), 100).substr(0, 9), "zebrageo ");
 }
 
+// A job's options are checked as `zebrageo run --options FILE` checks
+// them, and GET /options gives what `zebrageo run --print-options` prints.
+TEST(RunInvocation, JobOptionsAreCheckedAsTheClisOptionsFile) {
+  EXPECT_EQ(RunOptionsProblem(json::object()), "");
+  EXPECT_EQ(
+      RunOptionsProblem({{"rematch", false},
+                         {"adjustment", {{"solver", {{"num_threads", 1}}}}}}),
+      "");
+  EXPECT_NE(RunOptionsProblem(json::array()), "");
+  const std::string unknown = RunOptionsProblem({{"colour", "red"}});
+  EXPECT_NE(unknown.find("colour"), std::string::npos) << unknown;
+  const std::string refused = RunOptionsProblem({{"threads", -1}});
+  EXPECT_NE(refused.find("threads"), std::string::npos) << refused;
+  const std::string wrong_type =
+      RunOptionsProblem({{"adjustment", {{"solver", {{"num_threads", "x"}}}}}});
+  EXPECT_NE(wrong_type.find("adjustment.solver.num_threads"), std::string::npos)
+      << wrong_type;
+  const json defaults = DefaultRunOptions();
+  ASSERT_TRUE(defaults.is_object());
+  EXPECT_TRUE(defaults.contains("adjustment")) << defaults.dump(1);
+  EXPECT_TRUE(defaults.contains("reconstruction"));
+  EXPECT_EQ(RunOptionsProblem(defaults), "");  // the defaults read back
+}
+
 // Every route the server has is in server/openapi.json, and every path
 // and method there is a route: the document is the API.
 TEST(OpenApi, DocumentsEveryRouteAndNoOther) {

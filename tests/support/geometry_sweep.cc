@@ -15,11 +15,12 @@
 #include <sstream>
 #include <thread>
 
-#include "adjustment/adjustment_io.h"
 #include "adjustment/trajectory_adjuster.h"
-#include "pipeline/stages.h"
+#include "pipeline/adjust_outputs.h"
+#include "pipeline/adjustment_pass.h"
+#include "pipeline/rematch_stage.h"
 #include "registration/band_matcher.h"
-#include "registration/match_stage.h"
+#include "registration/observations.h"
 #include "registration/roadmark_index.h"
 #include "simulator/simulated_survey.h"
 #include "survey/math_util.h"
@@ -274,16 +275,14 @@ std::string GeometryRunResult::Line() const {
   return out.str();
 }
 
-// One second registration pass as `zebrageo run` does it (pipeline.cc):
-// the matches the adjustment rejected removed, then the pass on the
-// adjusted trajectory (on the road lines' alone when the adjustment had
-// too few crossings, and when that adds nothing on the adjusted one near
-// the `fitted_line_times`). Adds the vertex matches the adjustment
-// rejected to *rejected.
+// One second registration pass as `zebrageo run` does it
+// (pipeline/rematch_stage.h), with the truth's paint probe: the matches the
+// adjustment rejected removed, then the pass. Adds the vertex matches the
+// adjustment rejected to *rejected.
 RematchSummary SecondPass(
     const Survey& survey, const SyntheticReconstruction& reconstruction,
     const std::vector<ReconstructedLinePoint>* lines,
-    const std::vector<double>* line_control_times,
+    const std::vector<double>& line_control_times,
     const std::vector<double>& fitted_line_times, const TruthPaintProbe& probe,
     const AdjustmentOptions& adjustment, const AdjustmentResult& adjusted,
     AdjustmentData* data, std::vector<CrossingDecision>* decisions,
@@ -291,45 +290,24 @@ RematchSummary SecondPass(
   std::string rejected_list;  // RemoveRejectedMatches' message
   *rejected += RemoveRejectedMatches(adjusted, &data->matches, decisions,
                                      &rejected_list);
-  AdjustmentRecord record =
+  const AdjustmentRecord record =
       AdjustmentRecordOf(*data, adjustment, adjusted, nullptr);
-  RematchInput first;
-  first.vertices = &reconstruction.vertices;
-  first.matches = &data->matches;
-  first.decisions = decisions;
-  first.adjusted_trajectory = &adjusted.corrected_samples;
-  first.adjustment = &record;
-  first.line_control_times = line_control_times;
-  const std::set<std::string> rejected_crossings = RejectedCrossings(adjusted);
-  first.rejected_crossings = &rejected_crossings;
-  std::optional<RoadLinesAdjustment> on_lines;
-  if (SecondPassOnRoadLines(record, *decisions, lines != nullptr)) {
-    AdjustmentData without_matches = *data;
-    without_matches.matches.clear();
-    on_lines = AdjustByRoadLinesAlone(without_matches, lines, adjustment);
-    if (on_lines) {
-      first.adjustment = &on_lines->record;
-      first.adjusted_trajectory = &on_lines->trajectory;
-      first.line_control_times = &on_lines->line_control_times;
-    }
-  }
-  first.paint_probe = [&probe](int64_t exposure_id, const Pose& pose,
-                               const BandCornersEnu& band,
-                               const std::vector<BandCornersEnu>& seen) {
-    return probe.Classify(exposure_id, pose, band, seen);
-  };
-  RematchSummary summary = RematchWithAdjustedTrajectory(
-      survey, first, MatchOptions(), RematchOptions());
-  if (on_lines && summary.added == 0 && summary.dropped == 0 &&
-      record.counts.control_crossings > 0 && !fitted_line_times.empty()) {
-    first.adjustment = &record;
-    first.adjusted_trajectory = &adjusted.corrected_samples;
-    first.line_control_times = &fitted_line_times;
-    first.across_from_fitted_lines = true;
-    summary = RematchWithAdjustedTrajectory(survey, first, MatchOptions(),
-                                            RematchOptions());
-  }
-  return summary;
+  AdjustedTrajectory trajectory;
+  trajectory.record = &record;
+  trajectory.trajectory = &adjusted.corrected_samples;
+  trajectory.line_control_times = line_control_times;
+  trajectory.fitted_line_times = fitted_line_times;
+  trajectory.rejected_crossings = RejectedCrossings(adjusted);
+  RunOptions options;
+  options.lines = lines != nullptr;
+  options.adjustment = adjustment;
+  return RematchStep(survey, options, trajectory, reconstruction.vertices,
+                     data->matches, *decisions, lines, {},
+                     [&probe](int64_t exposure_id, const Pose& pose,
+                              const BandCornersEnu& band,
+                              const std::vector<BandCornersEnu>& seen) {
+                       return probe.Classify(exposure_id, pose, band, seen);
+                     });
 }
 
 // What `zebrageo run` does after its first adjustment (pipeline.cc): the
@@ -340,29 +318,28 @@ RematchSummary SecondPass(
 int RematchAndAdjust(const Survey& survey,
                      const SyntheticReconstruction& reconstruction,
                      const std::vector<ReconstructedLinePoint>* lines,
-                     const std::vector<double>* line_control_times,
+                     std::vector<double> line_control_times,
                      std::vector<double> fitted_line_times,
                      const TruthPaintProbe& probe,
                      const AdjustmentOptions& adjustment, AdjustmentData* data,
                      std::vector<CrossingDecision> decisions,
                      AdjustmentResult* adjusted, int* rejected) {
-  constexpr int kMaxPasses = 3;  // pipeline.cc's kMaxRematchPasses
+  constexpr int kMaxPasses = 3;  // adjust_stage.cc's kMaxRematchPasses
   int added = 0;
   *rejected = 0;
-  std::vector<double> times_after;  // line control of a later adjustment
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     RematchSummary rematch = SecondPass(
-        survey, reconstruction, lines,
-        pass == 0 ? line_control_times : &times_after, fitted_line_times, probe,
-        adjustment, *adjusted, data, &decisions, rejected);
+        survey, reconstruction, lines, line_control_times, fitted_line_times,
+        probe, adjustment, *adjusted, data, &decisions, rejected);
     if (rematch.added == 0 && rematch.dropped == 0) break;
     added += rematch.added;
     data->matches = std::move(rematch.matches);
     decisions = std::move(rematch.decisions);
-    std::vector<std::string> warnings;
-    *adjusted = AdjustWithRoadLines(*data, data->Input(), adjustment, lines, "",
-                                    &warnings, nullptr, &times_after,
-                                    &fitted_line_times);
+    AdjustmentPass again = AdjustWithRoadLines(
+        *data, data->Input(), adjustment, LineRegistrationOptions(), lines);
+    *adjusted = std::move(again.result);
+    line_control_times = std::move(again.line_control_times);
+    fitted_line_times = std::move(again.fitted_line_times);
   }
   return added;
 }
@@ -445,18 +422,15 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
     if (!options.guard) adjustment.never_worse.guard_sigmas = 0.0;
     AdjustmentData data =
         AdjustmentDataOf(survey, reconstruction.vertices, match.matches);
-    std::vector<std::string> warnings;
-    std::vector<double> line_control_times;
-    std::vector<double> fitted_line_times;
-    AdjustmentResult adjusted = AdjustWithRoadLines(
-        data, data.Input(), adjustment, lines, "", &warnings, nullptr,
-        &line_control_times, &fitted_line_times);
+    AdjustmentPass first = AdjustWithRoadLines(
+        data, data.Input(), adjustment, LineRegistrationOptions(), lines);
+    AdjustmentResult adjusted = std::move(first.result);
     int rejected_first = 0;
     if (options.rematch && adjusted.summary.IsUsable()) {
-      result.rematched =
-          RematchAndAdjust(survey, reconstruction, lines, &line_control_times,
-                           fitted_line_times, probe, adjustment, &data,
-                           match.decisions, &adjusted, &rejected_first);
+      result.rematched = RematchAndAdjust(
+          survey, reconstruction, lines, first.line_control_times,
+          first.fitted_line_times, probe, adjustment, &data, match.decisions,
+          &adjusted, &rejected_first);
     }
     const std::vector<VertexMatch>& matches = data.matches;
     // Scored as the user gets them: matches.csv keeps only the vertices

@@ -54,8 +54,8 @@ struct GeometrySweepOptions {
   // with the adjusted trajectory, and the adjustment again if that added
   // matches. false: match, then adjust once.
   bool rematch = true;
-  // Road lines as `zebrageo run` uses them (pipeline/stages.h): the lane
-  // lines' points synthesised (synthetic_lines.h), control in the
+  // Road lines as `zebrageo run` uses them (pipeline/adjustment_pass.h): the
+  // lane lines' points synthesised (synthetic_lines.h), control in the
   // adjustment, and the trajectory they alone correct searched by the
   // second pass when the adjustment had too few crossings. false: zebra
   // crossings only.

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "survey/input_error.h"
+#include "survey/results_report.h"
 #include "tests/survey/test_util.h"
 
 namespace zebrageo {
@@ -138,11 +139,9 @@ TEST(AdjustmentRecord, ReaderNamesTheProblem) {
               HasSubstr("field 'usable'"));
 }
 
-TEST(ReportJson, WrittenWithTheGivenIndent) {
+TEST(ReportJson, WrittenIndentedByOne) {
   TemporaryFolder folder;
   const std::string path = folder.Path("report.json");
-  WriteReportJson(nlohmann::json{{"a", 1}}, path, 2);
-  EXPECT_EQ(TextOf(path), "{\n  \"a\": 1\n}\n");
   WriteReportJson(nlohmann::json{{"a", 1}}, path);
   EXPECT_EQ(TextOf(path), "{\n \"a\": 1\n}\n");
 }

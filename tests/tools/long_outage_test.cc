@@ -20,7 +20,7 @@
 #include <sstream>
 #include <string>
 
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 #include "simulator/simulated_survey.h"
 #include "survey/survey.h"
 #include "tests/support/geometry_sweep.h"
@@ -127,7 +127,7 @@ TEST_F(LongOutage, TheGuardKeepsTheInputWhereTheResultIsWorseAndSaysSo) {
   ReportInputs inputs;
   inputs.survey = &survey;
   inputs.results_folder = results.string();
-  const nlohmann::json report = WriteReport(inputs, ReportOptions());
+  const nlohmann::json report = RunReportStage(inputs, ReportOptions());
   ASSERT_TRUE(fs::exists(results / "report.json"));
   const nlohmann::json& guard = report["adjustment"]["guard"];
   EXPECT_TRUE(guard["input_kept"].get<bool>());

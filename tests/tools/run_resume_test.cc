@@ -189,5 +189,133 @@ TEST_F(RunResume, KilledDuringAdjustThenRerunGivesTheSameResults) {
   KillDuringStageThenRerun("adjust", std::chrono::milliseconds(50));
 }
 
+// SIGINT while the adjust stage runs: the run stops at its next checkpoint
+// (between solves), exits 6 ("cancelled"), leaves no file half-written and
+// none of the stage's outputs; the rerun resumes to the reference results.
+TEST_F(RunResume, CancelledDuringAdjustThenRerunGivesTheSameResults) {
+  const std::string results = folder_->Path("cancelled");
+  const pid_t pid =
+      Spawn({"--log-level", "error", "run", survey_, "-o", results});
+  ASSERT_GT(pid, 0);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(300);
+  while (!StageInProgress(results, "adjust") &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+  ASSERT_EQ(WEXITSTATUS(status), 6) << "the run ended before the cancel";
+  ASSERT_TRUE(StageInProgress(results, "adjust"));
+  for (const std::string& file : FilesUnder(results)) {
+    EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+  }
+  for (const char* file :
+       {"trajectory_corrected.csv", "poses.csv", "gcp_residuals.csv",
+        "bands.geojson", "adjustment.json", "report.json"}) {
+    EXPECT_FALSE(fs::exists(results + "/" + file)) << file;
+  }
+  const std::string err = folder_->Path("cancelled.err");
+  ASSERT_EQ(RunZebrageo("run " + Quote(survey_) + " -o " + Quote(results),
+                        folder_->Path("cancelled.out"), err),
+            0)
+      << ReadWholeFile(err);
+  ExpectSameResults(reference_, results);
+}
+
+// The stages report.json lists as resumed.
+std::vector<std::string> ResumedStages(const std::string& results) {
+  const json report = json::parse(ReadWholeFile(results + "/report.json"));
+  return report.at("resumed_stages").get<std::vector<std::string>>();
+}
+
+// One option changed through --options reruns the stages that read it
+// (and those after them), and only those: an adjustment option resumes
+// the reconstruction; the match stage runs again because the adjustment
+// rewrote its matches.csv (pipeline/run_state.h). The same options again
+// resume everything, and a report option reruns no stage.
+TEST_F(RunResume, AChangedOptionRerunsTheStagesThatReadIt) {
+  const std::string results = folder_->Path("options");
+  fs::copy(reference_, results, fs::copy_options::recursive);
+  const std::string options = folder_->Write(
+      "sideslip.json",
+      R"({"adjustment": {"vehicle_motion": {"sideslip_sigma_rad": 0.0035}}})");
+  const std::string run = "run " + Quote(survey_) + " -o " + Quote(results);
+  const std::string err = folder_->Path("options.err");
+  ASSERT_EQ(RunZebrageo(run + " --options " + Quote(options),
+                        folder_->Path("options.out"), err),
+            0)
+      << ReadWholeFile(err);
+  EXPECT_EQ(ResumedStages(results), std::vector<std::string>{"reconstruct"});
+  // The option reached the adjustment: another trajectory.
+  EXPECT_NE(ReadWholeFile(results + "/trajectory_corrected.csv"),
+            ReadWholeFile(reference_ + "/trajectory_corrected.csv"));
+
+  ASSERT_EQ(RunZebrageo(run + " --options " + Quote(options),
+                        folder_->Path("options.out"), err),
+            0)
+      << ReadWholeFile(err);
+  EXPECT_EQ(ResumedStages(results),
+            (std::vector<std::string>{"reconstruct", "match", "adjust"}));
+
+  const std::string report_options =
+      folder_->Write("report.json", R"({"adjustment": {"vehicle_motion":
+         {"sideslip_sigma_rad": 0.0035}}, "report": {"max_sigma0": 1.5}})");
+  ASSERT_EQ(RunZebrageo(run + " --options " + Quote(report_options),
+                        folder_->Path("options.out"), err),
+            0)
+      << ReadWholeFile(err);
+  EXPECT_EQ(ResumedStages(results),
+            (std::vector<std::string>{"reconstruct", "match", "adjust"}));
+}
+
+// `run --print-options` prints every option, and an options file is
+// checked before anything runs: a member it does not know, or a value out
+// of range, is a usage error naming it.
+TEST_F(RunResume, OptionsAreCheckedAndPrinted) {
+  const std::string out = folder_->Path("print.out");
+  const std::string err = folder_->Path("print.err");
+  ASSERT_EQ(RunZebrageo("run --print-options", out, err), 0)
+      << ReadWholeFile(err);
+  const json printed = json::parse(ReadWholeFile(out));
+  EXPECT_EQ(printed.at("adjustment").at("model").at("knot_spacing_s"), 1.0);
+  EXPECT_TRUE(printed.at("lines").get<bool>());
+
+  const std::string unknown =
+      folder_->Write("unknown.json", R"({"adjustment": {"knots": 2}})");
+  const std::string results = folder_->Path("refused");
+  EXPECT_EQ(RunZebrageo("run " + Quote(survey_) + " -o " + Quote(results) +
+                            " --options " + Quote(unknown),
+                        out, err),
+            2);
+  EXPECT_NE(ReadWholeFile(err).find("adjustment.knots: not an option"),
+            std::string::npos)
+      << ReadWholeFile(err);
+  EXPECT_FALSE(fs::exists(results));
+
+  const std::string bad = folder_->Write(
+      "bad.json", R"({"matching": {"max_drift_m": -1}, "lines": false})");
+  ASSERT_EQ(
+      RunZebrageo("run --print-options --no-rematch --options " + Quote(bad),
+                  out, err),
+      2);
+  EXPECT_NE(ReadWholeFile(err).find("matching.max_drift_m = -1: must be > 0"),
+            std::string::npos)
+      << ReadWholeFile(err);
+  // The flags apply over the file.
+  const std::string lines_off =
+      folder_->Write("lines.json", R"({"lines": false})");
+  ASSERT_EQ(RunZebrageo("run --print-options --no-rematch --options " +
+                            Quote(lines_off),
+                        out, err),
+            0);
+  const json applied = json::parse(ReadWholeFile(out));
+  EXPECT_FALSE(applied.at("lines").get<bool>());
+  EXPECT_FALSE(applied.at("rematch").get<bool>());
+}
+
 }  // namespace
 }  // namespace zebrageo

@@ -1,4 +1,4 @@
-#include "pipeline/edge_control.h"
+#include "registration/edge_registration.h"
 
 #include <glog/logging.h>
 
@@ -6,8 +6,6 @@
 #include <cmath>
 #include <map>
 #include <set>
-
-#include "registration/edge_matcher.h"
 
 namespace zebrageo {
 namespace {
@@ -22,13 +20,13 @@ constexpr double kMinEdgeGateM = 0.3;
 constexpr double kEdgeGateSigmas = 4.0;
 
 // The database crossings of `edges` near bands the zebra front-end
-// reconstructed (put in ENU with the trajectory of `zebra_result`).
+// reconstructed (put in ENU with the corrected trajectory).
 std::set<std::string> CrossingsSeenWhole(
-    const AdjustmentData& data, const AdjustmentResult& zebra_result,
+    const LineRegistrationInput& input,
     const std::unordered_map<int64_t, double>& exposure_time,
     const std::vector<DatabaseCrossingEdge>& edges) {
   std::set<std::string> seen;
-  for (const VertexMatch& m : data.matches) seen.insert(m.crossing_id);
+  for (const VertexMatch& m : *input.matches) seen.insert(m.crossing_id);
   std::map<std::string, Eigen::Vector2d> centre;
   std::map<std::string, int> count;
   for (const DatabaseCrossingEdge& e : edges) {
@@ -39,11 +37,11 @@ std::set<std::string> CrossingsSeenWhole(
     }
   }
   for (auto& [id, c] : centre) c /= count[id];
-  for (const ReconstructedVertex& v : data.vertices) {
+  for (const ReconstructedVertex& v : *input.vertices) {
     const auto t = exposure_time.find(v.exposure_id);
     Pose pose;
     if (t == exposure_time.end() ||
-        !CorrectedPoseAt(zebra_result, t->second, &pose)) {
+        !CorrectedPoseAt(input.trajectory, t->second, &pose)) {
       continue;
     }
     const Eigen::Vector2d p = (pose.T_enu_body() * v.p_body).head<2>();
@@ -57,14 +55,14 @@ std::set<std::string> CrossingsSeenWhole(
 }  // namespace
 
 int AddCrossingEdgeControl(
-    const AdjustmentData& data, const AdjustmentOptions& options,
-    const AdjustmentResult& zebra_result,
     const std::vector<ReconstructedLinePoint>& points,
     const std::unordered_map<int64_t, double>& exposure_time,
+    const LineRegistrationInput& input,
+    const CrossingEdgeMatchOptions& match_options,
     std::vector<LineControlPoint>* control, std::vector<LineMatch>* rows) {
   if (points.empty()) return 0;
   const std::vector<DatabaseCrossingEdge> database =
-      DatabaseCrossingEdges(data.roadmarks, data.frame);
+      DatabaseCrossingEdges(*input.roadmarks, *input.frame);
   if (database.empty()) return 0;
   // Each reconstructed edge's points (file order is point order), in ENU.
   std::map<int64_t, std::vector<int>> of_line;
@@ -82,7 +80,7 @@ int AddCrossingEdgeControl(
     const auto t = exposure_time.find(points[indices.front()].exposure_id);
     Pose pose;
     if (t == exposure_time.end() ||
-        !CorrectedPoseAt(zebra_result, t->second, &pose)) {
+        !CorrectedPoseAt(input.trajectory, t->second, &pose)) {
       continue;
     }
     std::vector<Eigen::Vector3d> enu;
@@ -92,16 +90,15 @@ int AddCrossingEdgeControl(
     pose_of.push_back(pose);
     time_of.push_back(t->second);
   }
-  CrossingEdgeMatchOptions match_options;
   std::vector<CrossingEdgeMatch> matches;
   // With zebra control the gate follows the corrected trajectory's sd.
   for (size_t e = 0; e < edges_enu.size(); ++e) {
     CrossingEdgeMatchOptions o = match_options;
-    if (zebra_result.summary.corrected) {
+    if (input.trajectory.corrected) {
       o.gate_m = std::min(
-          o.gate_m,
-          std::max(kMinEdgeGateM,
-                   kEdgeGateSigmas * PosteriorSdAt(zebra_result, time_of[e])));
+          o.gate_m, std::max(kMinEdgeGateM,
+                             kEdgeGateSigmas *
+                                 PosteriorSdAt(input.trajectory, time_of[e])));
     }
     for (CrossingEdgeMatch m :
          MatchCrossingEdges({edges_enu[e]}, database, o)) {
@@ -110,7 +107,7 @@ int AddCrossingEdgeControl(
     }
   }
   const std::set<std::string> seen =
-      CrossingsSeenWhole(data, zebra_result, exposure_time, database);
+      CrossingsSeenWhole(input, exposure_time, database);
   const size_t first = control->size();
   std::vector<CrossingEdgeMatch> kept;
   std::map<int, int> points_on;  // database edge: control points
@@ -125,8 +122,7 @@ int AddCrossingEdgeControl(
     const Eigen::Vector3d direction(db.direction.x(), db.direction.y(), 0.0);
     // The database's error is the crossing's, shared by every point on
     // the edge: counted once over them.
-    const double db_sigma =
-        std::max(db.sigma_xy_m, options.min_database_sigma_m);
+    const double db_sigma = std::max(db.sigma_xy_m, input.min_database_sigma_m);
     const double shared_variance = points_on[m.db_edge] * db_sigma * db_sigma;
     const Eigen::Matrix3d R = pose_of[m.edge].q_enu_body.toRotationMatrix();
     for (size_t k = 0; k < edge_points[m.edge].size(); ++k) {

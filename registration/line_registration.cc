@@ -1,28 +1,22 @@
-// The road lines as control in the adjustment (issue 9): matched with the
-// trajectory the zebra crossings corrected, then a second adjustment with
-// the lines (pipeline/adjust_stage.cc).
+#include "registration/line_registration.h"
+
 #include <glog/logging.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
 #include <iomanip>
 #include <map>
 #include <set>
 #include <sstream>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
-#include "pipeline/edge_control.h"
-#include "pipeline/stages.h"
-#include "reconstruction/road_lines.h"
-#include "registration/dash_matcher.h"
-#include "registration/line_matcher.h"
-#include "registration/line_offset.h"
+#include "registration/edge_registration.h"
 #include "survey/math_util.h"
-#include "survey/results_lines.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -74,13 +68,13 @@ struct LinePointsEnu {
 LinePointsEnu LinePointsInEnu(
     const std::vector<ReconstructedLinePoint>& points,
     const std::unordered_map<int64_t, double>& exposure_time,
-    const AdjustmentResult& zebra_result) {
+    const CorrectedTrajectory& trajectory) {
   LinePointsEnu out;
   for (size_t i = 0; i < points.size(); ++i) {
     const auto t = exposure_time.find(points[i].exposure_id);
     Pose pose;
     if (t == exposure_time.end() ||
-        !CorrectedPoseAt(zebra_result, t->second, &pose)) {
+        !CorrectedPoseAt(trajectory, t->second, &pose)) {
       continue;
     }
     out.enu.push_back({points[i].line_id, RoadLineTypeName(points[i].type),
@@ -96,6 +90,7 @@ LinePointsEnu LinePointsInEnu(
 // track by the offset the lines agree on (line_offset.h); the points of
 // windows without one removed.
 void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
+                           const LateralOffsetOptions& options,
                            LinePointsEnu* points) {
   std::vector<Eigen::Vector2d> left_of;
   for (const Pose& pose : points->pose_of) {
@@ -103,7 +98,6 @@ void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
     const Eigen::Vector3d right = pose.q_enu_body * Eigen::Vector3d::UnitY();
     left_of.push_back(-right.head<2>().normalized());
   }
-  const LateralOffsetOptions options;
   const std::vector<LateralOffset> offsets = SearchLateralOffsets(
       points->enu, points->time_of, left_of, database, options);
   LinePointsEnu kept;
@@ -141,8 +135,7 @@ void ShiftByLateralOffsets(const std::vector<DatabaseLineEnu>& database,
 // warning is listed once in report.json) and lists it in `summary`.
 void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
                        const std::vector<DatabaseLineEnu>& database,
-                       const AdjustmentOptions& options,
-                       LineControlRecord* summary,
+                       bool log_warnings, LineControlRecord* summary,
                        std::vector<std::string>* warnings) {
   for (const RejectedLine& r : rejected) {
     const DatabaseLineEnu& line = database[r.db_line];
@@ -151,7 +144,11 @@ void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
       << std::fixed << std::setprecision(2) << std::abs(r.offset_m)
       << " m across from where the other lines put it: repainted or stale, "
          "not used as control";
-    LogAdjustmentWarning(options, w.str());
+    if (log_warnings) {
+      LOG(WARNING) << w.str();
+    } else {
+      VLOG(1) << w.str();
+    }
     warnings->push_back(w.str());
     summary->rejected_lines.push_back(
         {line.id, line.type, r.points, r.offset_m});
@@ -165,7 +162,7 @@ void WarnRejectedLines(const std::vector<RejectedLine>& rejected,
 LineControlPoint ControlPointOf(const ReconstructedLinePoint& p, double time,
                                 const Pose& pose, const LinePointMatch& m,
                                 const DatabaseLineEnu& line, double shared,
-                                const AdjustmentOptions& options,
+                                double min_database_sigma_m,
                                 bool* cross_track) {
   LineControlPoint c;
   c.time = time;
@@ -177,8 +174,8 @@ LineControlPoint ControlPointOf(const ReconstructedLinePoint& p, double time,
       DatabaseLineGrade(line, m.db_segment, m.db_segment_t, kGradeHalfWindowM);
   c.sqrt_information = LineSqrtInformation(
       p.covariance_body, pose.q_enu_body.toRotationMatrix(), m.across_enu,
-      shared * std::max(line.sigma_xy_m, options.min_database_sigma_m),
-      shared * std::max(line.sigma_z_m, options.min_database_sigma_m));
+      shared * std::max(line.sigma_xy_m, min_database_sigma_m),
+      shared * std::max(line.sigma_z_m, min_database_sigma_m));
   // Across the line is cross-track when the line runs with the vehicle.
   const Eigen::Vector3d forward = pose.q_enu_body * Eigen::Vector3d::UnitX();
   *cross_track = std::abs(m.along_enu.dot(forward)) > 0.7;
@@ -212,11 +209,11 @@ int AddDashControl(const std::vector<ReconstructedLinePoint>& points,
                    const LinePointsEnu& line_points,
                    const std::vector<LinePointMatch>& matches,
                    const std::vector<DatabaseLineEnu>& database,
-                   const AdjustmentResult& zebra_result,
-                   const AdjustmentOptions& options,
+                   const CorrectedTrajectory& trajectory,
+                   double min_database_sigma_m,
+                   const DashMatchOptions& dash_options,
                    std::vector<LineControlPoint>* control,
                    std::vector<LineMatch>* rows) {
-  const DashMatchOptions dash_options;
   const std::vector<int> db_dashes = DatabaseDashes(database, dash_options);
   if (db_dashes.empty()) return 0;
   // The database line each reconstructed line's kept points agree on, or
@@ -251,7 +248,7 @@ int AddDashControl(const std::vector<ReconstructedLinePoint>& points,
     if (db == db_line_of.end() || db->second < 0 || e.first == e.second) {
       continue;
     }
-    const double sd = PosteriorSdAt(zebra_result, line_points.time_of[e.first]);
+    const double sd = PosteriorSdAt(trajectory, line_points.time_of[e.first]);
     dashes.push_back({line_points.enu[e.first].p_enu,
                       line_points.enu[e.second].p_enu,
                       std::max(kMinDashGateM, kLineGateSigmas * sd)});
@@ -283,7 +280,7 @@ int AddDashControl(const std::vector<ReconstructedLinePoint>& points,
     // The database dash's error is shared by every exposure that saw it.
     const double db_sigma =
         std::sqrt(static_cast<double>(seen_of_db_dash[m.db_line])) *
-        std::max(line.sigma_xy_m, options.min_database_sigma_m);
+        std::max(line.sigma_xy_m, min_database_sigma_m);
     const Eigen::Matrix3d R = pose.q_enu_body.toRotationMatrix();
     const Eigen::Matrix3d covariance_enu =
         R * (0.25 * (a.covariance_body + b.covariance_body)) * R.transpose();
@@ -329,85 +326,29 @@ void LogLineControl(size_t used, size_t reconstructed, double stretch_s,
             << (along > 0 ? "; whole dashes the along-track position" : "");
 }
 
-}  // namespace
-
-// The corrected body pose at `time` (InterpolatePoses, as Trajectory does:
-// linear in position, slerp in attitude between the corrected samples);
-// false outside them.
-bool CorrectedPoseAt(const AdjustmentResult& result, double time, Pose* pose) {
-  const auto& samples = result.corrected_samples;
-  if (samples.size() < 2 || time < samples.front().time ||
-      time > samples.back().time) {
-    return false;
-  }
-  const auto it = std::upper_bound(
-      samples.begin(), samples.end(), time,
-      [](double t, const TrajectorySample& s) { return t < s.time; });
-  const size_t i = std::min<size_t>(
-      std::max<ptrdiff_t>(0, it - samples.begin() - 1), samples.size() - 2);
-  const double span = samples[i + 1].time - samples[i].time;
-  const double u = span > 0.0 ? (time - samples[i].time) / span : 0.0;
-  *pose = InterpolatePoses(result.corrected_poses[i],
-                           result.corrected_poses[i + 1], u);
-  return true;
-}
-
-// The posterior horizontal sd (radial) of the corrected trajectory at
-// `time`: from the nearest corrected sample (its sd_* are the posterior
-// ones when the adjustment computed them).
-double PosteriorSdAt(const AdjustmentResult& result, double time) {
-  const auto& samples = result.corrected_samples;
-  if (samples.empty()) return 0.0;
-  const auto it = std::lower_bound(
-      samples.begin(), samples.end(), time,
-      [](const TrajectorySample& s, double t) { return s.time < t; });
-  const TrajectorySample& s = it == samples.end() ? samples.back() : *it;
-  return std::hypot(s.sd_enu_m.x(), s.sd_enu_m.y());
-}
-
-std::vector<LineControlPoint> MatchLinesForAdjustment(
-    const AdjustmentData& data, const AdjustmentOptions& options,
-    const AdjustmentResult& zebra_result,
-    const std::vector<ReconstructedLinePoint>* reconstructed_lines,
-    const std::string& results_folder, std::vector<std::string>* warnings) {
-  std::vector<LineControlPoint> control;
-  if (reconstructed_lines == nullptr) return control;
-  // Crossing edges are matched to the database's crossings, apart.
-  std::vector<ReconstructedLinePoint> points, edge_points;
-  for (const ReconstructedLinePoint& p : *reconstructed_lines) {
-    (p.type == RoadLineType::kCrossingEdge ? edge_points : points).push_back(p);
-  }
-  if (data.roadmarks.lines.empty()) {
-    warnings->push_back(
-        "the road-mark database has no lines: road lines not used");
-    if (edge_points.empty()) return control;
-    points.clear();
-  }
-  std::unordered_map<int64_t, double> exposure_time;
-  for (const Exposure& e : data.exposures.exposures) {
-    exposure_time[e.exposure_id] = e.time;
-  }
-  const std::vector<DatabaseLineEnu> database =
-      DatabaseLinesEnu(data.roadmarks, data.frame);
-  LinePointsEnu line_points =
-      LinePointsInEnu(points, exposure_time, zebra_result);
-  if (!zebra_result.summary.corrected) {
-    ShiftByLateralOffsets(database, &line_points);
-  }
-  const std::vector<LinePointMatch> all_matches =
-      MatchLinePoints(line_points.enu, database, LineMatchOptions());
+// The reconstructed line points matched to database lines and kept: those
+// of the lines that agree with each other and, with a corrected trajectory,
+// with it (*rejected: the others); *all_matches: every point matched.
+std::vector<LinePointMatch> AcceptedLineMatches(
+    const LinePointsEnu& line_points,
+    const std::vector<DatabaseLineEnu>& database,
+    const CorrectedTrajectory& trajectory,
+    const LineRegistrationOptions& options, std::vector<RejectedLine>* rejected,
+    size_t* all_matches) {
+  const std::vector<LinePointMatch> matched =
+      MatchLinePoints(line_points.enu, database, options.lines);
+  *all_matches = matched.size();
   std::vector<LinePointMatch> consistent;
   std::set<int> checked;
-  std::vector<RejectedLine> rejected =
-      RejectInconsistentLines(all_matches, line_points.time_of,
-                              LineConsistencyOptions(), &consistent, &checked);
+  *rejected = RejectInconsistentLines(
+      matched, line_points.time_of, options.consistency, &consistent, &checked);
   // A database line must also agree with the trajectory the zebra crossings
   // corrected, to what that trajectory's posterior sd allows: a line the
   // zebras place decimetres away is stale or mismatched, and would pull
   // the trajectory off the crossings.
   std::vector<double> sd_of_point(line_points.enu.size(), 0.0);
   for (size_t i = 0; i < line_points.enu.size(); ++i) {
-    sd_of_point[i] = PosteriorSdAt(zebra_result, line_points.time_of[i]);
+    sd_of_point[i] = PosteriorSdAt(trajectory, line_points.time_of[i]);
   }
   // Without a corrected trajectory (no zebra crossing was control) there is
   // nothing to check the lines against but each other (the input's stated
@@ -415,26 +356,33 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
   // neighbour, a lane away less the drift: only lines another painted line
   // vouched for are control.
   std::vector<LinePointMatch> matches;
-  if (zebra_result.summary.corrected) {
+  if (trajectory.corrected) {
     for (const RejectedLine& r :
          RejectLinesAwayFromTrajectory(consistent, sd_of_point, &matches)) {
-      rejected.push_back(r);
+      rejected->push_back(r);
     }
   } else {
     for (const LinePointMatch& m : consistent) {
       if (checked.count(m.db_line)) matches.push_back(m);
     }
   }
-  LineControlRecord summary;
-  WarnRejectedLines(rejected, database, options, &summary, warnings);
+  return matches;
+}
 
-  std::vector<LineMatch> rows;
-  // Per 30 s stretch: matches, and the directions controlled.
-  const double stretch_s = 30.0;
-  const double start_time = data.exposures.exposures.empty()
-                                ? 0.0
-                                : data.exposures.exposures.front().time;
-  std::map<int, std::array<int, 3>> stretches;  // cross-track, height, along
+// Control points per stretch of line_control.json: cross-track, height,
+// along-track, by stretch index.
+using Stretches = std::map<int, std::array<int, 3>>;
+
+// A control point per accepted line point, and its row of
+// line_matches.csv; counts them in *stretches.
+void AddLineControl(const std::vector<ReconstructedLinePoint>& points,
+                    const LinePointsEnu& line_points,
+                    const std::vector<LinePointMatch>& matches,
+                    const std::vector<DatabaseLineEnu>& database,
+                    const std::unordered_map<int64_t, double>& exposure_time,
+                    const LineRegistrationInput& input, double start_time,
+                    double stretch_s, Stretches* stretches,
+                    LineRegistration* out) {
   // The database's error is one per segment, shared by every point matched
   // to it (from several exposures): counted once, or the adjustment would
   // fit the database's noise (the heading follows the digitised line's
@@ -449,46 +397,102 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
         static_cast<double>(points_on_segment[{m.db_line, m.db_segment}]));
     const DatabaseLineEnu& line = database[m.db_line];
     bool cross_track = false;
-    control.push_back(ControlPointOf(p, exposure_time[p.exposure_id],
-                                     line_points.pose_of[m.point], m, line,
-                                     shared, options, &cross_track));
-    auto& s = stretches[static_cast<int>(
-        std::floor((control.back().time - start_time) / stretch_s))];
+    out->control.push_back(ControlPointOf(
+        p, exposure_time.at(p.exposure_id), line_points.pose_of[m.point], m,
+        line, shared, input.min_database_sigma_m, &cross_track));
+    auto& s = (*stretches)[static_cast<int>(
+        std::floor((out->control.back().time - start_time) / stretch_s))];
     if (cross_track) s[0] += 1;
     s[1] += 1;
-    rows.push_back({p.exposure_id, p.line_id, p.point, p.type, line.id,
-                    m.across_enu.head<2>(), m.distance_m, m.height_m,
-                    cross_track});
+    out->rows.push_back({p.exposure_id, p.line_id, p.point, p.type, line.id,
+                         m.across_enu.head<2>(), m.distance_m, m.height_m,
+                         cross_track});
   }
+}
+
+}  // namespace
+
+std::string LineRegistrationOptions::Check() const {
+  OptionCheck check;
+  OPTION_NESTED(check, lines);
+  OPTION_NESTED(check, consistency);
+  OPTION_NESTED(check, lateral_offsets);
+  OPTION_NESTED(check, dashes);
+  OPTION_NESTED(check, crossing_edges);
+  return check.problem();
+}
+
+LineRegistration RegisterRoadLines(
+    const std::vector<ReconstructedLinePoint>& reconstructed,
+    const LineRegistrationInput& input,
+    const LineRegistrationOptions& options) {
+  LineRegistration out;
+  // Crossing edges are matched to the database's crossings, apart.
+  std::vector<ReconstructedLinePoint> points, edge_points;
+  for (const ReconstructedLinePoint& p : reconstructed) {
+    (p.type == RoadLineType::kCrossingEdge ? edge_points : points).push_back(p);
+  }
+  if (input.roadmarks->lines.empty()) {
+    out.warnings.push_back(
+        "the road-mark database has no lines: road lines not used");
+    if (edge_points.empty()) return out;
+    points.clear();
+  }
+  std::unordered_map<int64_t, double> exposure_time;
+  for (const Exposure& e : input.exposures->exposures) {
+    exposure_time[e.exposure_id] = e.time;
+  }
+  const std::vector<DatabaseLineEnu> database =
+      DatabaseLinesEnu(*input.roadmarks, *input.frame);
+  LinePointsEnu line_points =
+      LinePointsInEnu(points, exposure_time, input.trajectory);
+  if (!input.trajectory.corrected) {
+    ShiftByLateralOffsets(database, options.lateral_offsets, &line_points);
+  }
+  std::vector<RejectedLine> rejected;
+  size_t all_matches = 0;
+  const std::vector<LinePointMatch> matches =
+      AcceptedLineMatches(line_points, database, input.trajectory, options,
+                          &rejected, &all_matches);
+  LineControlRecord record;
+  WarnRejectedLines(rejected, database, input.log_warnings, &record,
+                    &out.warnings);
+
+  // Per 30 s stretch: matches, and the directions controlled.
+  const double stretch_s = 30.0;
+  const double start_time = input.exposures->exposures.empty()
+                                ? 0.0
+                                : input.exposures->exposures.front().time;
+  Stretches stretches;
+  AddLineControl(points, line_points, matches, database, exposure_time, input,
+                 start_time, stretch_s, &stretches, &out);
   // Along the track: whole dashes, once the crossings corrected the
   // trajectory (without them its along-track error is unbounded, and a
   // dash period off would match the next dash).
-  const size_t first_along = control.size();
-  if (zebra_result.summary.corrected) {
-    AddDashControl(points, line_points, matches, database, zebra_result,
-                   options, &control, &rows);
+  const size_t first_along = out.control.size();
+  if (input.trajectory.corrected) {
+    AddDashControl(points, line_points, matches, database, input.trajectory,
+                   input.min_database_sigma_m, options.dashes, &out.control,
+                   &out.rows);
   }
   // Along the track too: the edges of crossings never seen whole.
-  AddCrossingEdgeControl(data, options, zebra_result, edge_points,
-                         exposure_time, &control, &rows);
-  for (size_t i = first_along; i < control.size(); ++i) {
+  AddCrossingEdgeControl(edge_points, exposure_time, input,
+                         options.crossing_edges, &out.control, &out.rows);
+  for (size_t i = first_along; i < out.control.size(); ++i) {
     stretches[static_cast<int>(
-        std::floor((control[i].time - start_time) / stretch_s))][2] += 1;
+        std::floor((out.control[i].time - start_time) / stretch_s))][2] += 1;
   }
   LogLineControl(matches.size(), points.size(), stretch_s, stretches);
-  if (results_folder.empty()) return control;
-  const std::filesystem::path folder(results_folder);
-  WriteLineMatches(rows, (folder / kLineMatchesFile).string());
-  summary.stretch_s = stretch_s;
-  summary.reconstructed_points = static_cast<int64_t>(points.size());
-  summary.matched_points = static_cast<int64_t>(all_matches.size());
-  summary.used_points = static_cast<int64_t>(matches.size());
+  record.stretch_s = stretch_s;
+  record.reconstructed_points = static_cast<int64_t>(points.size());
+  record.matched_points = static_cast<int64_t>(all_matches);
+  record.used_points = static_cast<int64_t>(matches.size());
   for (const auto& [k, s] : stretches) {
-    summary.stretches.push_back({k * stretch_s, (k + 1) * stretch_s,
-                                 start_time + k * stretch_s, s[0], s[1], s[2]});
+    record.stretches.push_back({k * stretch_s, (k + 1) * stretch_s,
+                                start_time + k * stretch_s, s[0], s[1], s[2]});
   }
-  WriteLineControl(summary, (folder / kLineControlFile).string());
-  return control;
+  out.record = std::move(record);
+  return out;
 }
 
 }  // namespace zebrageo

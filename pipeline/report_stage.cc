@@ -1,4 +1,4 @@
-#include "pipeline/report.h"
+#include "pipeline/report_stage.h"
 
 #include <glog/logging.h>
 
@@ -14,15 +14,17 @@
 #include <tuple>
 
 #include "pipeline/report_data.h"
+#include "pipeline/version.h"
 #include "survey/atomic_file.h"
 #include "survey/input_error.h"
+#include "survey/math_util.h"
+#include "survey/option_check.h"
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
-#include "tools/version.h"
+#include "survey/results_report.h"
 
 namespace zebrageo {
 using report_internal::Collect;
-using report_internal::kRadToDeg;
 using report_internal::RenderHtml;
 using report_internal::ReportData;
 
@@ -39,13 +41,6 @@ std::vector<std::string> WithoutRepeats(const std::vector<std::string>& texts) {
     if (seen.insert(text).second) unique.push_back(text);
   }
   return unique;
-}
-
-double Rms(const std::vector<double>& values) {
-  if (values.empty()) return 0.0;
-  double sum = 0.0;
-  for (double v : values) sum += v * v;
-  return std::sqrt(sum / values.size());
 }
 
 json GcpStatistics(const ReportData& data, GcpRole role) {
@@ -395,18 +390,11 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
 }  // namespace
 
 std::string ReportOptions::Check() const {
-  if (!(max_uncontrolled_stretch_m > 0.0)) {
-    return "max_uncontrolled_stretch_m = " +
-           std::to_string(max_uncontrolled_stretch_m) + ": must be > 0";
-  }
-  if (!(control_radius_m > 0.0)) {
-    return "control_radius_m = " + std::to_string(control_radius_m) +
-           ": must be > 0";
-  }
-  if (!(max_sigma0 > 0.0)) {
-    return "max_sigma0 = " + std::to_string(max_sigma0) + ": must be > 0";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GT(check, max_uncontrolled_stretch_m, 0.0);
+  OPTION_GT(check, control_radius_m, 0.0);
+  OPTION_GT(check, max_sigma0, 0.0);
+  return check.problem();
 }
 
 json BuildReport(const ReportInputs& inputs, const ReportOptions& options) {
@@ -418,7 +406,7 @@ std::string RenderReportHtml(const json& report, const ReportInputs& inputs) {
   return RenderHtml(report, Collect(inputs));
 }
 
-json WriteReport(const ReportInputs& inputs, const ReportOptions& options) {
+json RunReportStage(const ReportInputs& inputs, const ReportOptions& options) {
   CHECK(inputs.survey != nullptr);
   const std::string error = options.Check();
   if (!error.empty()) throw std::invalid_argument("ReportOptions: " + error);
@@ -427,8 +415,7 @@ json WriteReport(const ReportInputs& inputs, const ReportOptions& options) {
   const std::string html = RenderHtml(report, data);
   const std::string folder = inputs.results_folder + "/";
   WriteReportJson(report, folder + kReportJsonFile);
-  WriteFileAtomically(folder + kReportHtmlFile,
-                      [&](std::ostream& out) { out << html; });
+  WriteReportHtml(html, folder + kReportHtmlFile);
   return report;
 }
 

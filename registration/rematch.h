@@ -1,26 +1,15 @@
-// The match stage on a survey and its results folder (SURVEY_FORMAT.md,
-// "Stage outputs"): reads RESULTS/reconstructed_bands.csv, matches the bands
-// to the survey's road-mark database (band_matcher.h) and writes
-//   matches.csv             reconstructed vertex <-> database vertex
-//   crossing_decisions.csv  one row per (exposure, group): matched, refused
-//                           or no_candidate, and why
-//   match_evidence.json     the evidence behind each decision, the database
-//                           faults found, the options and the summary
-//   matches.geojson         for QGIS: each matched vertex as a line from its
-//                           measured placement to its database corner, the
-//                           matched bands placed with the estimated
-//                           correction, and the database faults as points
-// Every file is written atomically.
-#ifndef ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_
-#define ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_
+// The second registration pass (pipeline/rematch_stage.h runs it after
+// each adjustment): the observations the first pass left undecided, matched
+// again on the trajectory the adjustment corrected.
+#ifndef ZEBRAGEO_REGISTRATION_REMATCH_H_
+#define ZEBRAGEO_REGISTRATION_REMATCH_H_
 
-#include <functional>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "registration/band_matcher.h"
-#include "registration/roadmark_index.h"
+#include "survey/exposures.h"
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
 #include "survey/results_lines.h"
@@ -28,46 +17,7 @@
 
 namespace zebrageo {
 
-inline constexpr char kMatchEvidenceFile[] = "match_evidence.json";
-inline constexpr char kMatchesGeoJsonFile[] = "matches.geojson";
-
-// Groups reconstructed vertices into observations (one per exposure and
-// group), with the measured pose at each exposure. Bands with fewer than 4
-// vertices cannot be matched vertex by vertex: they are left out and
-// counted in `incomplete_bands` (may be null). Throws InputError naming
-// `display_name` for an exposure_id the survey does not have or a pair index
-// the rig does not have.
-std::vector<CrossingObservation> BuildObservations(
-    const Survey& survey, const std::vector<ReconstructedVertex>& vertices,
-    const std::string& display_name, int* incomplete_bands);
-
-// The measured pose of every exposure of the survey.
-std::vector<ExposurePose> ExposurePoses(const Survey& survey);
-
-// Writers (atomic).
-void WriteMatchEvidence(const MatchResult& result, const MatchOptions& options,
-                        const std::vector<std::string>& warnings,
-                        const LocalFrame& frame, const std::string& path);
-void WriteMatchesGeoJson(const MatchInput& input, const MatchResult& result,
-                         const LocalFrame& frame, const std::string& path);
-
-// The whole stage on the reconstruction's bands (what
-// reconstructed_bands.csv holds), writing its files into results_folder.
-// Throws InputError for inconsistent inputs. The result's summary says
-// whether the matcher ran (IsUsable).
-MatchResult RunMatchStage(const Survey& survey,
-                          const std::vector<ReconstructedVertex>& vertices,
-                          const std::string& results_folder,
-                          const MatchOptions& options,
-                          const std::function<void(int, int)>& progress = {});
-// The same with the bands read from results_folder/reconstructed_bands.csv
-// (InputError when missing or unreadable).
-MatchResult RunMatchStage(const Survey& survey,
-                          const std::string& results_folder,
-                          const MatchOptions& options,
-                          const std::function<void(int, int)>& progress = {});
-
-// The second registration pass of `zebrageo run`: the observations the first
+// The second registration pass: the observations the first
 // pass left undecided (refused as ambiguous, no candidate) are matched again
 // with the ADJUSTED trajectory (RESULTS/trajectory_corrected.csv). Where the
 // adjustment controls it (road lines hold the cross-track position between
@@ -153,6 +103,20 @@ struct RematchOptions {
   // needs.
   double max_sideways_m = 0.2;
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("min_control_crossings", min_control_crossings);
+    v("gate_m", gate_m);
+    v("sd_gate_factor", sd_gate_factor);
+    v("max_heading_error_rad", max_heading_error_rad);
+    v("min_hit_bands", min_hit_bands);
+    v("cross_track_gate_m", cross_track_gate_m);
+    v("max_line_control_gap_m", max_line_control_gap_m);
+    v("max_line_drift_sd_m", max_line_drift_sd_m);
+    v("max_line_bracket_gap_s", max_line_bracket_gap_s);
+    v("max_cross_track_control_gap_m", max_cross_track_control_gap_m);
+    v("max_sideways_m", max_sideways_m);
+  }
 };
 struct RematchSummary {
   int observations = 0;   // undecided after the first pass
@@ -194,33 +158,19 @@ struct RematchInput {
   // nothing to them again: the next adjustment would face the same
   // conflict and might reject the other side of it instead.
   const std::set<std::string>* rejected_crossings = nullptr;
+  // Stops the pass's matching (MatchBands).
+  CancellationToken cancel;
 };
-// The crossings of results_folder's gcp_residuals.csv with a rejected
-// vertex; empty without the file.
-std::set<std::string> RejectedCrossingsIn(const std::string& results_folder);
 // The times of the exposures of line_matches.csv's rows that constrain
 // the position across their line, sorted.
 std::vector<double> LineControlTimes(const std::vector<LineMatch>& rows,
                                      const ExposureTable& exposures);
-// The same from results_folder's line_matches.csv; empty without it.
-std::vector<double> LineControlTimesIn(const std::string& results_folder,
-                                       const ExposureTable& exposures);
-// Writes nothing (WriteRematchResults does).
+// In memory: the pipeline writes the files (pipeline/rematch_stage.h).
 RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
                                              const RematchInput& first,
-                                             const MatchOptions& options,
-                                             const RematchOptions& rematch);
-// When the pass added or removed matches: matches.csv and
-// crossing_decisions.csv rewritten with them (atomically).
-void WriteRematchResults(const RematchSummary& summary,
-                         const std::string& results_folder);
-// The same from the files of results_folder, and the files rewritten.
-// Throws InputError for unreadable inputs.
-RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
-                                             const std::string& results_folder,
                                              const MatchOptions& options,
                                              const RematchOptions& rematch);
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_REGISTRATION_MATCH_STAGE_H_
+#endif  // ZEBRAGEO_REGISTRATION_REMATCH_H_

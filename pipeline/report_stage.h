@@ -1,4 +1,4 @@
-// The survey report: report.json for programs and a self-contained
+// The report stage: report.json for programs and a self-contained
 // report.html (inline SVG plots, no network) for the mapping engineer.
 //
 // It is built from a results folder alone (plus the survey): the stage
@@ -6,8 +6,8 @@
 // crossing_decisions.csv, matches.csv, match_evidence.json,
 // adjustment.json, reconstruction.json) and the run's stage timings.
 // Missing files only remove sections; they are listed as warnings.
-#ifndef ZEBRAGEO_PIPELINE_REPORT_H_
-#define ZEBRAGEO_PIPELINE_REPORT_H_
+#ifndef ZEBRAGEO_PIPELINE_REPORT_STAGE_H_
+#define ZEBRAGEO_PIPELINE_REPORT_STAGE_H_
 
 #include <nlohmann/json.hpp>
 #include <string>
@@ -33,6 +33,12 @@ struct ReportOptions {
   double max_sigma0 = 2.0;
 
   std::string Check() const;
+  template <typename Visitor>
+  void VisitFields(Visitor& v) {
+    v("max_uncontrolled_stretch_m", max_uncontrolled_stretch_m);
+    v("control_radius_m", control_radius_m);
+    v("max_sigma0", max_sigma0);
+  }
 };
 
 struct ReportInputs {
@@ -51,11 +57,11 @@ nlohmann::json BuildReport(const ReportInputs& inputs,
 // Renders the HTML page of a report built by BuildReport.
 std::string RenderReportHtml(const nlohmann::json& report,
                              const ReportInputs& inputs);
-// BuildReport, then writes report.json and report.html atomically into
-// the results folder. Returns the report.
-nlohmann::json WriteReport(const ReportInputs& inputs,
-                           const ReportOptions& options);
+// The report stage: BuildReport, then report.json and report.html written
+// into the results folder (survey/results_report.h). Returns the report.
+nlohmann::json RunReportStage(const ReportInputs& inputs,
+                              const ReportOptions& options);
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_PIPELINE_REPORT_H_
+#endif  // ZEBRAGEO_PIPELINE_REPORT_STAGE_H_

@@ -1,4 +1,4 @@
-#include "registration/match_stage.h"
+#include "pipeline/match_stage.h"
 
 #include <gtest/gtest.h>
 
@@ -11,6 +11,9 @@
 #include <set>
 #include <sstream>
 
+#include "pipeline/rematch_stage.h"
+#include "pipeline/stage_results.h"
+#include "registration/observations.h"
 #include "survey/input_error.h"
 #include "survey/results_adjustment.h"
 #include "survey/survey.h"
@@ -18,6 +21,33 @@
 
 namespace zebrageo {
 namespace {
+
+// The match stage on a results folder (pipeline/match_stage.h), its matches
+// and decisions as it left them.
+MatchResult RunMatchStage(const Survey& survey, const std::string& folder,
+                          const MatchOptions& options) {
+  StageResults results(folder);
+  RunOptions run;
+  run.matching = options;
+  MatchResult result;
+  result.summary = zebrageo::RunMatchStage(survey, &results, run);
+  result.matches = results.Matches();
+  result.decisions = results.Decisions();
+  return result;
+}
+
+// `zebrageo match --second-pass` on a results folder
+// (pipeline/rematch_stage.h).
+RematchSummary RematchWithAdjustedTrajectory(const Survey& survey,
+                                             const std::string& folder,
+                                             const MatchOptions& matching,
+                                             const RematchOptions& rematch) {
+  StageResults results(folder);
+  RunOptions run;
+  run.matching = matching;
+  run.second_pass = rematch;
+  return RunRematchStage(survey, &results, run);
+}
 
 namespace fs = std::filesystem;
 

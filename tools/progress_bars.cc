@@ -1,4 +1,4 @@
-#include "tools/progress.h"
+#include "tools/progress_bars.h"
 
 #include <glog/logging.h>
 #include <unistd.h>

@@ -1,4 +1,6 @@
-// Road lines as control (issue 9, step 3): point-to-line residuals.
+// Road lines as control (issue 9, step 3): point-to-line residuals of the
+// control points registration/line_registration.h makes
+// (survey/line_control_points.h).
 //
 // A point of a reconstructed road line (body frame, at an exposure time t)
 // matched to a database line (registration/line_matcher.h) is placed in ENU
@@ -15,8 +17,8 @@
 // tilt of the trajectory). S: the whitening of both uncertainties (the
 // reconstruction's covariance rotated to ENU, plus the database's sigma_xy
 // and sigma_z). Along the line nothing is constrained.
-#ifndef ZEBRAGEO_ADJUSTMENT_LINE_CONTROL_H_
-#define ZEBRAGEO_ADJUSTMENT_LINE_CONTROL_H_
+#ifndef ZEBRAGEO_ADJUSTMENT_LINE_COSTS_H_
+#define ZEBRAGEO_ADJUSTMENT_LINE_COSTS_H_
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/rotation.h>
@@ -28,34 +30,10 @@
 
 #include "adjustment/cost_functions.h"
 #include "adjustment/trajectory_correction.h"
+#include "survey/line_control_points.h"
 #include "survey/trajectory.h"
 
 namespace zebrageo {
-
-// One matched line point, as the adjustment reads it.
-struct LineControlPoint {
-  double time = 0.0;
-  Eigen::Vector3d p_body = Eigen::Vector3d::Zero();
-  Eigen::Vector3d db_point_enu = Eigen::Vector3d::Zero();
-  Eigen::Vector3d across_enu = Eigen::Vector3d::UnitX();  // horizontal unit
-  Eigen::Vector3d along_enu = Eigen::Vector3d::UnitY();   // horizontal unit
-  double grade = 0.0;  // of the database segment: dz per horizontal metre
-  // Whitening of [across, up] (2 x 2, lower triangular).
-  Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();
-  // A dash's centre on the database dash's (registration/dash_matcher.h):
-  // it holds the position ALONG the dash, so across_enu holds the dash's
-  // direction and row 0 of the whitening its sd; row 1 is zero (the dash's
-  // points hold the height). The same residual; never a cross-track
-  // discrepancy.
-  bool along_track = false;
-};
-
-// S such that S C S^T = I for the 2 x 2 covariance of [across, up]:
-// covariance_body rotated by R_enu_body, plus the database's sigmas.
-Eigen::Matrix2d LineSqrtInformation(const Eigen::Matrix3d& covariance_body,
-                                    const Eigen::Matrix3d& R_enu_body,
-                                    const Eigen::Vector3d& across_enu,
-                                    double db_sigma_xy_m, double db_sigma_z_m);
 
 // The residual as a function of the trajectory correction c at t (6).
 class LinePointError {
@@ -137,4 +115,4 @@ class LinePointCost : public ceres::SizedCostFunction<2, kKnotSize, kKnotSize,
 
 }  // namespace zebrageo
 
-#endif  // ZEBRAGEO_ADJUSTMENT_LINE_CONTROL_H_
+#endif  // ZEBRAGEO_ADJUSTMENT_LINE_COSTS_H_

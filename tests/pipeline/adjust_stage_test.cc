@@ -1,0 +1,78 @@
+// The adjust stage's files (pipeline/adjust_stage.h) on a synthetic survey:
+// every contract output written once, readable by the survey's readers.
+#include "pipeline/adjust_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "pipeline/adjustment_pass.h"
+#include "survey/input_error.h"
+#include "survey/results.h"
+#include "tests/support/synthetic_survey.h"
+#include "tests/survey/test_util.h"
+
+namespace zebrageo {
+namespace {
+
+SyntheticSurveyOptions KilometreOptions() {
+  SyntheticSurveyOptions options;
+  options.num_exposures = 120;
+  options.database_offset_m = 0.03;
+  return options;
+}
+
+TEST(AdjustStage, WritesEveryContractOutputReadableByTheSurveyReaders) {
+  const SyntheticSurvey survey = MakeSyntheticSurvey(KilometreOptions());
+  TemporaryFolder folder;
+  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
+  SurveyLoadOptions load_options;
+  load_options.require_images = false;
+  const Survey loaded = LoadSurvey(folder.Path("survey"), load_options);
+  StageResults results(folder.Path("results"));
+  RunOptions options;
+  options.tie_points = false;  // no images
+  options.rematch = false;
+  RunAdjustStage(loaded, &results, options);
+  const auto poses =
+      ReadCameraPoses(folder.Path("results/poses.csv"), "poses.csv");
+  EXPECT_EQ(poses.size(), survey.exposures.images.size());
+  const auto samples = ReadTrajectorySamples(
+      folder.Path("results/trajectory_corrected.csv"), "trajectory_corrected");
+  ASSERT_EQ(samples.size(), survey.measured_samples.size());
+  for (size_t i = 0; i < samples.size(); ++i) {
+    ASSERT_EQ(samples[i].time, survey.measured_samples[i].time);
+  }
+  const auto gcps = ReadGcpResiduals(folder.Path("results/gcp_residuals.csv"),
+                                     "gcp_residuals.csv");
+  EXPECT_FALSE(gcps.empty());
+  EXPECT_FALSE(
+      ReadAdjustedBands(folder.Path("results/bands.geojson"), "bands.geojson")
+          .empty());
+  for (const char* name : {"adjustment.json", "colmap/cameras.txt",
+                           "colmap/images.txt", "colmap/points3D.txt"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(
+        folder.Path(std::string("results/") + name)))
+        << name;
+  }
+  // report.json is the report stage's.
+  EXPECT_FALSE(std::filesystem::exists(folder.Path("results/report.json")));
+}
+
+TEST(AdjustStage, MissingStageOutputsNameTheStageToRun) {
+  const SyntheticSurvey survey = MakeSyntheticSurvey(KilometreOptions());
+  TemporaryFolder folder;
+  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
+  std::filesystem::remove(folder.Path("results/matches.csv"));
+  try {
+    LoadAdjustmentData(folder.Path("survey"), folder.Path("results"));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("zebrageo match"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace zebrageo
