@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <sstream>
@@ -68,6 +69,20 @@ struct Range {
     max += pad;
   }
 };
+
+// FNV-1a, 64 bits, as 16 hex digits: stable across compilers (std::hash
+// is not).
+std::string HexHash(const std::string& text) {
+  uint64_t hash = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    hash ^= c;
+    hash *= 1099511628211ULL;
+  }
+  char buffer[17];
+  std::snprintf(buffer, sizeof(buffer), "%016llx",
+                static_cast<unsigned long long>(hash));
+  return buffer;
+}
 
 }  // namespace
 
@@ -230,9 +245,23 @@ void SvgPlot::WriteAxes(const Area& area, std::ostream& svg) const {
 }
 
 void SvgPlot::WriteData(const Area& area, std::ostream& svg) const {
-  svg << "<clipPath id='c'><rect x='" << kMarginLeft << "' y='" << kMarginTop
-      << "' width='" << area.plot_w << "' height='" << area.plot_h
-      << "'/></clipPath><g clip-path='url(#c)'>\n";
+  // An id is global to the HTML page: one shared id made every plot clip
+  // to the first plot's area (issue 47). The id is a hash of the data, so
+  // the page stays the same from run to run; two plots with the same id
+  // have the same data and the same clip rectangle.
+  std::ostringstream data;
+  WriteMarks(area, data);
+  const std::string marks = data.str();
+  const std::string id =
+      "clip-" + HexHash(title_ + "|" + std::to_string(area.plot_w) + "|" +
+                        std::to_string(area.plot_h) + "|" + marks);
+  svg << "<clipPath id='" << id << "'><rect x='" << kMarginLeft << "' y='"
+      << kMarginTop << "' width='" << area.plot_w << "' height='" << area.plot_h
+      << "'/></clipPath><g clip-path='url(#" << id << ")'>\n"
+      << marks << "</g>\n";
+}
+
+void SvgPlot::WriteMarks(const Area& area, std::ostream& svg) const {
   for (const PlotSeries& s : series_) {
     const size_t n = std::min(s.x.size(), s.y.size());
     if (s.markers) {
@@ -244,8 +273,14 @@ void SvgPlot::WriteData(const Area& area, std::ostream& svg) const {
                                (colour_max_ - colour_min_));
         }
         svg << "<circle cx='" << Number(area.X(s.x[i]), 1) << "' cy='"
-            << Number(area.Y(s.y[i]), 1) << "' r='2.5' fill='" << colour
-            << "'/>";
+            << Number(area.Y(s.y[i]), 1) << "' r='" << s.marker_radius_px
+            << "' fill='" << colour << "'";
+        if (i < s.point_ids.size()) {
+          svg << " data-id='" << EscapeHtml(s.point_ids[i]) << "'><title>"
+              << EscapeHtml(s.point_ids[i]) << "</title></circle>";
+        } else {
+          svg << "/>";
+        }
       }
       svg << "\n";
       continue;
@@ -274,7 +309,6 @@ void SvgPlot::WriteData(const Area& area, std::ostream& svg) const {
     }
     svg << "\n";
   }
-  svg << "</g>\n";
 }
 
 void SvgPlot::WriteLegend(int margin_right, std::ostream& svg) const {
@@ -310,7 +344,9 @@ std::string SvgPlot::Render() const {
   std::ostringstream svg;
   svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << width_px_
       << "' height='" << height_px_ << "' viewBox='0 0 " << width_px_ << " "
-      << height_px_ << "' font-family='sans-serif' font-size='11'>\n";
+      << height_px_ << "' font-family='sans-serif' font-size='11'";
+  if (!name_.empty()) svg << " data-plot='" << EscapeHtml(name_) << "'";
+  svg << ">\n";
   svg << "<rect width='100%' height='100%' fill='white'/>\n";
   svg << "<text x='" << width_px_ / 2 << "' y='16' text-anchor='middle' "
       << "font-size='14' font-weight='bold'>" << EscapeHtml(title_)
@@ -330,7 +366,8 @@ std::string SvgPlot::Render() const {
 std::string RenderHistogram(const std::string& title,
                             const std::string& x_label,
                             const std::vector<double>& values, int bins,
-                            const std::string& colour) {
+                            const std::string& colour,
+                            const std::string& y_label) {
   Range range;
   for (double v : values) range.Add(v);
   if (!range.Valid()) {
@@ -348,7 +385,7 @@ std::string RenderHistogram(const std::string& title,
     ++counts[bin];
   }
   const double width = (range.max - range.min) / bins;
-  SvgPlot plot(title, x_label, "count", 360, 260);
+  SvgPlot plot(title, x_label, y_label, 360, 260);
   plot.SetNote(std::to_string(values.size()) + " values");
   // Bars as closed polylines keep SvgPlot's single data model.
   for (int i = 0; i < bins; ++i) {

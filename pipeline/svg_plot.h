@@ -16,8 +16,12 @@ struct PlotSeries {
   std::vector<double> x;
   std::vector<double> y;
   bool markers = false;  // points instead of a polyline
+  double marker_radius_px = 2.5;
   // Per-point values mapped to a colour scale (markers only); empty: plain.
   std::vector<double> colour_values;
+  // Per-point names (markers only): a tooltip, and the marker's data-id
+  // attribute (the render test finds each crossing's marker by it).
+  std::vector<std::string> point_ids;
 };
 
 struct PlotArrow {
@@ -38,6 +42,8 @@ class SvgPlot {
   void SetColourScale(double min_value, double max_value, std::string label);
   // Text drawn under the title (units, notes).
   void SetNote(std::string note) { note_ = std::move(note); }
+  // The SVG's data-plot attribute (tests and style sheets find it by it).
+  void SetName(std::string name) { name_ = std::move(name); }
 
   std::string Render() const;
 
@@ -51,11 +57,14 @@ class SvgPlot {
   Area AreaFor(int margin_right) const;
   // The frame, grid lines, ticks and axis labels.
   void WriteAxes(const Area& area, std::ostream& svg) const;
-  // The series and arrows, clipped to the plot area.
+  // The series and arrows, clipped to the plot area (a clip path of an id
+  // unique to the plot).
   void WriteData(const Area& area, std::ostream& svg) const;
+  // The series and arrows themselves.
+  void WriteMarks(const Area& area, std::ostream& svg) const;
   // The named series and the colour scale, right of the plot area.
   void WriteLegend(int margin_right, std::ostream& svg) const;
-  std::string title_, x_label_, y_label_, note_;
+  std::string title_, x_label_, y_label_, note_, name_;
   int width_px_, height_px_;
   std::vector<PlotSeries> series_;
   std::vector<PlotArrow> arrows_;
@@ -69,7 +78,8 @@ class SvgPlot {
 std::string RenderHistogram(const std::string& title,
                             const std::string& x_label,
                             const std::vector<double>& values, int bins,
-                            const std::string& colour = "#1f77b4");
+                            const std::string& colour = "#1f77b4",
+                            const std::string& y_label = "count");
 
 // Viridis-like colour for t in [0, 1].
 std::string ColourScale(double t);
