@@ -7,6 +7,7 @@
 #include "survey/input_error.h"
 #include "survey/json_file.h"
 #include "survey/math_util.h"
+#include "survey/output_crs.h"
 #include "survey/results_adjustment.h"
 #include "survey/results_lines.h"
 
@@ -96,19 +97,34 @@ ReportData Collect(const ReportInputs& inputs) {
   } else {
     data.missing_files.push_back(kCrossingDecisionsFile);
   }
+  std::vector<VertexMatch> matches;
   if (Exists(folder + kMatchesFile)) {
-    data.matched_vertices = static_cast<int>(
-        ReadMatches(folder + kMatchesFile, kMatchesFile).size());
+    matches = ReadMatches(folder + kMatchesFile, kMatchesFile);
+    data.matched_vertices = static_cast<int>(matches.size());
   }
+  std::vector<ReconstructedVertex> vertices;
   if (Exists(folder + kReconstructedBandsFile)) {
+    vertices = ReadReconstructedBands(folder + kReconstructedBandsFile,
+                                      kReconstructedBandsFile);
     std::set<int64_t> bands;
-    for (const ReconstructedVertex& v : ReadReconstructedBands(
-             folder + kReconstructedBandsFile, kReconstructedBandsFile)) {
-      bands.insert(v.band_id);
-    }
+    for (const ReconstructedVertex& v : vertices) bands.insert(v.band_id);
     data.reconstructed_bands = static_cast<int>(bands.size());
   } else {
     data.missing_files.push_back(kReconstructedBandsFile);
+  }
+  if (Exists(folder + kPosesFile) && !matches.empty()) {
+    data.image_residuals =
+        ReprojectControl(survey, data.residuals, matches, vertices,
+                         ReadCameraPoses(folder + kPosesFile, kPosesFile));
+  }
+  if (survey.manifest.output_crs.is_set()) {
+    data.output_crs = survey.manifest.output_crs.definition;
+    try {
+      data.output_crs_description = OutputCrs::Of(survey)->Description();
+    } catch (const std::exception& error) {
+      // The stages reported it; the report names the CRS as written.
+      data.output_crs_description = "";
+    }
   }
   if (Exists(folder + "match_evidence.json")) {
     data.match_evidence =

@@ -1,8 +1,10 @@
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "pipeline/report_data.h"
+#include "pipeline/report_tables.h"
 #include "pipeline/svg_plot.h"
 #include "pipeline/version.h"
 #include "survey/csv.h"
@@ -32,7 +34,7 @@ std::string ArrayTable(const json& rows, size_t max_rows = 500) {
   std::ostringstream html;
   html << "<table><tr>";
   for (const std::string& c : columns)
-    html << "<th>" << EscapeHtml(c) << "</th>";
+    html << "<th>" << EscapeHtml(HumanKey(c)) << "</th>";
   html << "</tr>\n";
   size_t shown = 0;
   for (const json& row : rows) {
@@ -51,21 +53,32 @@ std::string ArrayTable(const json& rows, size_t max_rows = 500) {
   return html.str();
 }
 
-std::string KeyValueTable(const json& object) {
+// `unit`: of every value (the keys name none), e.g. "s" for timings.
+std::string KeyValueTable(const json& object, const std::string& unit = "") {
+  const std::string suffix = unit.empty() ? "" : " (" + unit + ")";
   std::ostringstream html;
   html << "<table>";
   for (const auto& [key, value] : object.items()) {
     if (value.is_object()) {
+      // {"unit": "px", "before": ...}: the unit of the object's figures.
+      const std::string sub_unit = value.value("unit", std::string());
       for (const auto& [sub_key, sub_value] : value.items()) {
-        if (sub_value.is_object() || sub_value.is_array()) continue;
-        html << "<tr><th>" << EscapeHtml(key + " " + sub_key) << "</th><td>"
+        if (sub_value.is_object() || sub_value.is_array() ||
+            sub_key == "unit") {
+          continue;
+        }
+        std::string header = HumanKey(key + "_" + sub_key);
+        if (!sub_unit.empty() && sub_value.is_number_float()) {
+          header += " (" + sub_unit + ")";
+        }
+        html << "<tr><th>" << EscapeHtml(header) << "</th><td>"
              << JsonCell(sub_value) << "</td></tr>";
       }
       continue;
     }
     if (value.is_array()) continue;
-    html << "<tr><th>" << EscapeHtml(key) << "</th><td>" << JsonCell(value)
-         << "</td></tr>";
+    html << "<tr><th>" << EscapeHtml(HumanKey(key) + suffix) << "</th><td>"
+         << JsonCell(value) << "</td></tr>";
   }
   html << "</table>\n";
   return html.str();
@@ -105,6 +118,7 @@ std::string TrajectoryMap(const ReportData& data) {
     for (double v : track.colour_values) max_value = std::max(max_value, v);
     plot.SetColourScale(0.0, max_value, "horizontal correction (m)");
   }
+  plot.SetName("trajectory");
   plot.AddSeries(track);
   PlotSeries crossings;
   crossings.label = "database crossings";
@@ -113,6 +127,7 @@ std::string TrajectoryMap(const ReportData& data) {
   for (const auto& [id, centre] : data.crossing_centres_enu) {
     crossings.x.push_back(centre.x());
     crossings.y.push_back(centre.y());
+    crossings.point_ids.push_back(id);
   }
   plot.AddSeries(crossings);
   return plot.Render();
@@ -126,7 +141,7 @@ std::string CorrectionPlots(const ReportData& data) {
   for (double v : data.time_s) t.push_back(v - t0);
   t = Thin(t, kMaxPoints);
   SvgPlot position("Trajectory correction (corrected minus input)",
-                   "time since start (s)", "metres");
+                   "time since start (s)", "correction (m)");
   const char* names[3] = {"east", "north", "up"};
   const char* colours[3] = {"#1f77b4", "#2ca02c", "#ff7f0e"};
   for (int axis = 0; axis < 3; ++axis) {
@@ -139,7 +154,8 @@ std::string CorrectionPlots(const ReportData& data) {
     s.y = Thin(y, kMaxPoints);
     position.AddSeries(std::move(s));
   }
-  SvgPlot heading("Heading correction", "time since start (s)", "degrees");
+  SvgPlot heading("Heading correction", "time since start (s)",
+                  "heading correction (°)");
   PlotSeries h;
   h.label = "heading";
   h.colour = "#9467bd";
@@ -167,8 +183,31 @@ std::string ResidualPlots(const ReportData& data) {
   SvgPlot vectors("Horizontal GCP residuals (adjusted minus database)",
                   "east (m)", "north (m)", 860, 520);
   vectors.SetEqualAspect(true);
+  vectors.SetName("gcp");
   vectors.SetNote("arrows exaggerated x" + FormatFixed(scale, 0) +
                   "; blue = control, red = check");
+  // A marker per crossing with ground control, at its centre: visible
+  // whatever the arrows' lengths.
+  for (const GcpRole role : {GcpRole::kControl, GcpRole::kCheck}) {
+    PlotSeries markers;
+    markers.markers = true;
+    markers.marker_radius_px = 4.0;
+    markers.label =
+        role == GcpRole::kControl ? "control crossing" : "check crossing";
+    markers.colour = role == GcpRole::kControl ? "#1f77b4" : "#d62728";
+    std::map<std::string, bool> seen;
+    for (const GcpResidual& r : data.residuals) {
+      const auto centre = data.crossing_centres_enu.find(r.crossing_id);
+      if (r.role != role || centre == data.crossing_centres_enu.end() ||
+          !seen.emplace(r.crossing_id, true).second) {
+        continue;
+      }
+      markers.x.push_back(centre->second.x());
+      markers.y.push_back(centre->second.y());
+      markers.point_ids.push_back(r.crossing_id);
+    }
+    if (!markers.x.empty()) vectors.AddSeries(std::move(markers));
+  }
   for (size_t i = 0; i < data.residuals.size(); ++i) {
     const Eigen::Vector3d& p = data.residual_positions_enu[i];
     if (!p.allFinite()) continue;
@@ -183,19 +222,16 @@ std::string ResidualPlots(const ReportData& data) {
   }
   std::string html = vectors.Render();
   html += "<div class='row'>";
-  html += RenderHistogram("Control points: 3D residual", "cm", control, 20,
-                          "#1f77b4");
+  html += RenderHistogram("Control points: 3D residual", "3D residual (cm)",
+                          control, 20, "#1f77b4", "points");
   if (!check.empty()) {
-    html += RenderHistogram("Check points: 3D residual", "cm", check, 20,
-                            "#d62728");
+    html += RenderHistogram("Check points: 3D residual", "3D residual (cm)",
+                            check, 20, "#d62728", "points");
   }
   html += "</div>";
   return html;
 }
 
-// Before/after figure of the adjustment: per observation type, the RMS of
-// the residuals before (grey) and after (blue) as bars scaled to the larger
-// of the two (the types differ by orders of magnitude and in units).
 // Road-line control per stretch: how many matched line points constrained
 // each direction (lane lines: cross-track and height; along-track only
 // stop lines), against time, and the stretches as a table.
@@ -206,7 +242,7 @@ std::string RoadLineSection(const json& road_lines, const ReportData& data) {
   }
   const double t0 = data.time_s.empty() ? 0.0 : data.time_s.front();
   SvgPlot plot("Road-line control per stretch", "time since start (s)",
-               "matched line points");
+               "matched line points (count)");
   plot.SetNote(road_lines.value("note", std::string()));
   const char* keys[3] = {"cross_track_points", "height_points",
                          "along_track_points"};
@@ -252,52 +288,6 @@ std::string RoadLineSection(const json& road_lines, const ReportData& data) {
   return html.str();
 }
 
-std::string BeforeAfterFigure(const json& adjustment) {
-  if (!adjustment.is_object() || !adjustment.contains("rms")) return "";
-  constexpr int kRowPx = 44, kLabelPx = 230, kBarPx = 420, kWidthPx = 860;
-  std::ostringstream rows;
-  int n = 0;
-  for (const auto& [type, values] : adjustment["rms"].items()) {
-    if (!values.is_object() || !values.contains("before") ||
-        !values.contains("after") || !values["before"].is_number() ||
-        !values["after"].is_number()) {
-      continue;
-    }
-    const double before = values["before"].get<double>();
-    const double after = values["after"].get<double>();
-    const std::string unit = values.value("unit", "");
-    const double top = std::max({before, after, 1e-12});
-    const int y = 40 + n * kRowPx;
-    rows << "<text x='0' y='" << y + 16 << "'>" << EscapeHtml(type)
-         << "</text>";
-    int row = 0;
-    for (const auto& [value, colour, name] :
-         {std::tuple<double, const char*, const char*>{before, "#aaa",
-                                                       "before"},
-          {after, "#1f77b4", "after"}}) {
-      const int bar_y = y + row++ * 18;
-      const double w = std::max(1.0, kBarPx * value / top);
-      rows << "<rect x='" << kLabelPx << "' y='" << bar_y << "' width='"
-           << FormatFixed(w, 1) << "' height='14' fill='" << colour
-           << "'/><text x='" << kLabelPx + w + 6 << "' y='" << bar_y + 11
-           << "'>" << name << " " << FormatFixed(value, 3) << " "
-           << EscapeHtml(unit) << "</text>";
-    }
-    rows << "\n";
-    ++n;
-  }
-  if (n == 0) return "";
-  std::ostringstream svg;
-  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kWidthPx
-      << "' height='" << 50 + n * kRowPx << "' viewBox='0 0 " << kWidthPx << " "
-      << 50 + n * kRowPx << "' font-family='sans-serif' font-size='11'>\n"
-      << "<text x='" << kWidthPx / 2
-      << "' y='16' text-anchor='middle' font-size='14' font-weight='bold'>"
-      << "Residual RMS before and after the adjustment</text>\n"
-      << rows.str() << "</svg>\n";
-  return svg.str();
-}
-
 }  // namespace
 
 std::string RenderHtml(const json& report, const ReportData& data) {
@@ -313,6 +303,9 @@ std::string RenderHtml(const json& report, const ReportData& data) {
        << ".warn{background:#fff4e0;border-left:4px solid #f0a000;"
        << "padding:4px 10px;margin:4px 0}.none{color:#777}"
        << ".row{display:flex;flex-wrap:wrap;gap:12px}svg{margin:6px 0}"
+       << ".scroll{max-height:420px;overflow-y:auto;display:inline-block}"
+       << "tr.check td{background:#fdecec}tr.rejected td{color:#999;"
+       << "text-decoration:line-through}td{font-variant-numeric:tabular-nums}"
        << "</style></head><body>\n";
   html << "<h1>zebrageo report: " << EscapeHtml(name) << "</h1>\n";
   html << "<p>zebrageo " << ZEBRAGEO_VERSION_STRING << ". Survey "
@@ -320,7 +313,8 @@ std::string RenderHtml(const json& report, const ReportData& data) {
        << report["survey"]["exposures"] << " exposures, "
        << FormatFixed(report["survey"]["length_m"].get<double>(), 0) << " m, "
        << FormatFixed(report["survey"]["duration_s"].get<double>(), 1)
-       << " s.</p>\n";
+       << " s.</p>\n"
+       << CrsParagraph(data, report);
 
   html << "<h2>Warnings</h2>\n";
   if (report["warnings"].empty()) html << "<p class='none'>none</p>\n";
@@ -333,23 +327,9 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   html << "<p>Check points are crossings held out of the adjustment: their "
           "residuals are the honest accuracy figure (they include the "
           "database's own error).</p>\n";
-  json accuracy = json::array();
-  for (const char* role : {"control", "check"}) {
-    json row = report["gcp"][role];
-    row["role"] = role;
-    accuracy.push_back(row);
-  }
-  html << ArrayTable(accuracy);
+  html << AccuracyTable(report["gcp"]);
   if (!report["rms_before"].empty()) {
-    json rms = json::array();
-    for (const auto& [type, before] : report["rms_before"].items()) {
-      rms.push_back({{"observation", type},
-                     {"rms before", before},
-                     {"rms after", report["rms_after"].value(type, json())}});
-    }
-    html << "<p>RMS of the residuals per observation type, before and after "
-            "the adjustment:</p>\n"
-         << ArrayTable(rms) << BeforeAfterFigure(report["adjustment"]);
+    html << ObservationRmsSection(report["adjustment"]);
   }
   if (report.contains("corrections")) {
     html << "<p>Corrections applied to the trajectory:</p>\n"
@@ -374,7 +354,10 @@ std::string RenderHtml(const json& report, const ReportData& data) {
 
   html << "<h2>Trajectory</h2>\n"
        << TrajectoryMap(data) << CorrectionPlots(data);
-  html << "<h2>Ground control residuals</h2>\n" << ResidualPlots(data);
+  html << "<h2>Ground control residuals</h2>\n"
+       << ResidualPlots(data) << GcpTable(data);
+  html << "<h2>Reprojection residuals per camera</h2>\n"
+       << CameraResidualSection(data);
   html << "<h2>Crossings</h2>\n" << ArrayTable(report["crossings"]);
   html << "<p>Observations not matched, by reason:</p>\n"
        << ArrayTable(report["unmatched_reasons"]);
@@ -385,7 +368,7 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   html << "<h2>Road lines</h2>\n"
        << RoadLineSection(report.value("road_lines", json()), data);
   html << "<h2>Counts</h2>\n" << KeyValueTable(report["counts"]);
-  html << "<h2>Stage timings</h2>\n" << KeyValueTable(report["timings_s"]);
+  html << "<h2>Stage timings</h2>\n" << KeyValueTable(report["timings_s"], "s");
   if (report.contains("peak_memory_mb")) {
     html << "<p>Peak memory: "
          << FormatFixed(report["peak_memory_mb"].get<double>(), 0)

@@ -301,7 +301,8 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
       {"duration_s",
        survey.trajectory.end_time() - survey.trajectory.start_time()},
       {"length_m", data.length_m},
-      {"database_bands", survey.roadmarks.bands.size()}};
+      {"database_bands", survey.roadmarks.bands.size()},
+      {"output_crs", data.output_crs.empty() ? "WGS84" : data.output_crs}};
 
   int matched = 0, refused = 0, no_candidate = 0;
   std::set<std::string> matched_crossings;

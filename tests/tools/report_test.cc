@@ -8,9 +8,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -216,17 +218,109 @@ void ExpectReportPage(const std::string& html, const json& report) {
       titles.push_back(title[1]);
     }
   }
+  // One before/after chart per unit (issue 47: px and m in one chart made
+  // the bars incomparable), each unit once, then the other plots.
+  const std::string rms_title = "Residual RMS before and after the adjustment";
+  std::vector<std::string> units;
+  while (!titles.empty() && titles.front().rfind(rms_title, 0) == 0) {
+    units.push_back(titles.front().substr(rms_title.size()));
+    titles.erase(titles.begin());
+  }
+  EXPECT_GE(units.size(), 2u);
+  for (const char* unit : {" (px)", " (m)"}) {
+    EXPECT_EQ(std::count(units.begin(), units.end(), unit), 1) << unit;
+  }
   const std::vector<std::string> expected = {
-      "Residual RMS before and after the adjustment",
       "Trajectory and correction magnitude",
       "Trajectory correction (corrected minus input)",
       "Heading correction",
       "Horizontal GCP residuals (adjusted minus database)",
       "Control points: 3D residual",
+      "Control points: reprojection error",
       "Road-line control per stretch"};
   EXPECT_EQ(titles, expected);
   EXPECT_FALSE(std::regex_search(html, std::regex(R"(\b(nan|NaN|inf)\b)")))
       << "NaN or infinity in the page";
+}
+
+// Rows of the HTML table following `marker` in `html`: the text of each
+// row's cells (header row included).
+std::vector<std::vector<std::string>> TableAfter(const std::string& html,
+                                                 const std::string& marker) {
+  std::vector<std::vector<std::string>> rows;
+  const size_t from = html.find(marker);
+  if (from == std::string::npos) return rows;
+  const size_t begin = html.find("<table>", from);
+  const size_t end = html.find("</table>", begin);
+  if (begin == std::string::npos || end == std::string::npos) return rows;
+  const std::string table = html.substr(begin, end - begin);
+  const std::regex row("<tr[^>]*>(.*?)</tr>"), cell("<t[hd]>(.*?)</t[hd]>");
+  for (auto r = std::sregex_iterator(table.begin(), table.end(), row);
+       r != std::sregex_iterator(); ++r) {
+    const std::string text = (*r)[1];
+    std::vector<std::string> cells;
+    for (auto c = std::sregex_iterator(text.begin(), text.end(), cell);
+         c != std::sregex_iterator(); ++c) {
+      cells.push_back((*c)[1]);
+    }
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// Issue 47: the tables a photogrammetrist reads, with units, the CRS named,
+// one id per element.
+void ExpectQaTables(const std::string& html, const std::string& results) {
+  // Clip paths: one id per plot, never shared.
+  const std::regex id_attribute(" id='([^']*)'");
+  std::vector<std::string> ids;
+  for (auto m = std::sregex_iterator(html.begin(), html.end(), id_attribute);
+       m != std::sregex_iterator(); ++m) {
+    ids.push_back((*m)[1]);
+  }
+  std::sort(ids.begin(), ids.end());
+  EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end())
+      << "an id used twice";
+  EXPECT_GE(ids.size(), 5u);
+  // The output CRS named (the small survey has none: WGS84).
+  EXPECT_NE(html.find("Output CRS: WGS84 (EPSG:4979"), std::string::npos);
+  // Per control point: one row per line of gcp_residuals.csv, residuals in
+  // cm as the file's metres say.
+  std::vector<std::string> csv;
+  {
+    std::istringstream lines(ReadWholeFile(results + "/gcp_residuals.csv"));
+    for (std::string line; std::getline(lines, line);) csv.push_back(line);
+  }
+  const auto gcp = TableAfter(html, "Each database vertex matched");
+  ASSERT_GE(gcp.size(), 2u);
+  ASSERT_EQ(gcp[0].size(), 12u);
+  EXPECT_EQ(gcp[0][4], "East (cm)");
+  size_t data_lines = 0;
+  for (const std::string& line : csv) {
+    if (!line.empty() && line[0] != '#') ++data_lines;
+  }
+  EXPECT_EQ(gcp.size(), data_lines) << "header + one row per point";
+  for (size_t i = 1; i < gcp.size(); ++i) {
+    EXPECT_TRUE(gcp[i][3] == "control" || gcp[i][3] == "check" ||
+                gcp[i][3] == "rejected")
+        << gcp[i][3];
+    // A residual of the small survey is centimetres, not metres.
+    EXPECT_LT(std::abs(std::stod(gcp[i][8])), 100.0) << "3D (cm)";
+  }
+  // Per camera: the rig's two cameras, reprojection RMS of a few pixels.
+  const auto cameras = TableAfter(html, "<div id='camera-residuals'>");
+  ASSERT_EQ(cameras.size(), 3u) << "header + 2 cameras";
+  EXPECT_EQ(cameras[0][3], "RMS control (px)");
+  for (size_t i = 1; i < cameras.size(); ++i) {
+    EXPECT_GT(std::stoi(cameras[i][1]), 10) << "control observations";
+    const double rms_px = std::stod(cameras[i][3]);
+    EXPECT_GT(rms_px, 0.0);
+    EXPECT_LT(rms_px, 3.0) << cameras[i][0];
+  }
+  // Every column header of every table names its unit or is a count/name:
+  // no raw JSON key (snake_case) left.
+  EXPECT_FALSE(std::regex_search(html, std::regex("<th>[a-z0-9]+_[a-z0-9_]+")))
+      << "a raw JSON key as a header";
 }
 
 TEST(Report, RunWritesItsFiguresAndWellFormedPlotsAndReportRebuildsIt) {
@@ -251,6 +345,7 @@ TEST(Report, RunWritesItsFiguresAndWellFormedPlotsAndReportRebuildsIt) {
   {
     SCOPED_TRACE("report.html");
     ExpectReportPage(ReadWholeFile(results + "/report.html"), report);
+    ExpectQaTables(ReadWholeFile(results + "/report.html"), results);
   }
 
   // `zebrageo report` from the results folder alone: the same figures.
