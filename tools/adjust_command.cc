@@ -23,7 +23,8 @@ struct AdjustArguments {
   bool lines = true;
   bool self_calibrate = false;
   double check_share = RunOptions().adjustment.control.check_crossing_share;
-  int threads = RunOptions().adjustment.solver.num_threads;
+  int threads = 0;
+  const CLI::Option* threads_option = nullptr;
   double sideslip_sigma_deg =
       RadToDeg(RunOptions().adjustment.vehicle_motion.sideslip_sigma_rad);
 };
@@ -37,7 +38,7 @@ void RunAdjust(const AdjustArguments& args) {
   AdjustmentOptions& adjustment = options.adjustment;
   adjustment.control.check_crossing_share = args.check_share;
   adjustment.rig_calibration.self_calibrate_rig = args.self_calibrate;
-  adjustment.solver.num_threads = args.threads;
+  ApplyThreadsOption(*args.threads_option, args.threads, &options);
   adjustment.vehicle_motion.sideslip_sigma_rad =
       DegToRad(args.sideslip_sigma_deg);
   const std::string problem = options.Check();
@@ -85,8 +86,7 @@ void AddAdjustCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--check-share", args->check_share,
                   "share of matched crossings held out as check points")
       ->capture_default_str();
-  sub->add_option("--threads", args->threads, "solver threads")
-      ->capture_default_str();
+  args->threads_option = AddThreadsOption(sub, &args->threads);
   AddSideslipOption(sub, &args->sideslip_sigma_deg);
   commands->push_back({sub, [args] { RunAdjust(*args); }});
 }

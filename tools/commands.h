@@ -14,6 +14,8 @@
 
 namespace zebrageo {
 
+struct RunOptions;
+
 struct Command {
   CLI::App* subcommand = nullptr;
   // Runs the command after parsing. Throws InputError, NotImplementedError
@@ -55,6 +57,12 @@ CancellationToken CancelOnSignal();
 // --sideslip-sigma of adjust and run (AdjustmentOptions::sideslip_sigma_rad, in
 // degrees here).
 void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg);
+// --threads of run, reconstruct and adjust: one meaning in all three.
+CLI::Option* AddThreadsOption(CLI::App* subcommand, int* threads);
+// When --threads was given: every stage's threads, 0 one per hardware
+// thread (the solver's too); else the options' own (RunOptions defaults).
+void ApplyThreadsOption(const CLI::Option& option, int threads,
+                        RunOptions* options);
 // A runner for a stage that is not built yet: it validates the survey (so
 // the user learns whether it is readable), then throws NotImplementedError.
 std::function<void()> NotImplementedStage(std::shared_ptr<StageArguments> args,

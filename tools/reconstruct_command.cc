@@ -71,10 +71,7 @@ void AddReconstructCommand(CLI::App* app, std::vector<Command>* commands) {
                          "3D; writes reconstructed_bands.csv (and "
                          "reconstructed_lines.csv with --lines).",
                          &args->stage);
-  sub->add_option("--threads", args->threads,
-                  "worker threads (0: one per hardware thread)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  AddThreadsOption(sub, &args->threads);
   sub->add_option("--debug-images", args->debug_images,
                   "write images with edges, candidates and bands to DIR");
   sub->add_option("--camera-height", args->nominal_camera_height_m,

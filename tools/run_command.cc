@@ -44,11 +44,8 @@ bool Given(const RunArguments& args, const std::string& flag) {
 RunOptions OptionsOf(const RunArguments& args) {
   RunOptions options;
   if (!args.options_file.empty()) options = ReadRunOptions(args.options_file);
-  if (Given(args, "--threads")) {
-    options.threads = args.threads;
-    options.reconstruction.threads = args.threads;
-    if (args.threads > 0) options.adjustment.solver.num_threads = args.threads;
-  }
+  ApplyThreadsOption(*args.command->get_option("--threads"), args.threads,
+                     &options);
   if (Given(args, "--no-tie-points")) options.tie_points = args.tie_points;
   if (Given(args, "--no-lines")) options.lines = args.lines;
   if (Given(args, "--no-rematch")) options.rematch = args.rematch;
@@ -141,10 +138,7 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
   run->add_option("--from", run_args->from_stage,
                   "redo from this stage: reconstruct, match or adjust")
       ->check(CLI::IsMember({"reconstruct", "match", "adjust"}));
-  run->add_option("--threads", run_args->threads,
-                  "worker threads (0: one per hardware thread)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  AddThreadsOption(run, &run_args->threads);
   run->add_flag("!--no-tie-points", run_args->tie_points,
                 "do not match image features between exposures");
   run->add_flag("!--no-lines", run_args->lines,

@@ -1,13 +1,16 @@
 // What the stage commands share.
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/run_options.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
 
@@ -59,6 +62,25 @@ void AddSideslipOption(CLI::App* subcommand, double* sideslip_sigma_deg) {
                    "the heading between crossings. 0: not used")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+}
+
+CLI::Option* AddThreadsOption(CLI::App* subcommand, int* threads) {
+  return subcommand
+      ->add_option("--threads", *threads,
+                   "worker threads of each stage (0: one per hardware "
+                   "thread); unset: the options' (run --print-options)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+void ApplyThreadsOption(const CLI::Option& option, int threads,
+                        RunOptions* options) {
+  if (option.count() == 0) return;
+  options->threads = threads;
+  options->reconstruction.threads = threads;
+  options->adjustment.solver.num_threads =
+      threads > 0
+          ? threads
+          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
 namespace {

@@ -34,6 +34,36 @@ int Fail(ExitCode code, const std::string& message) {
   return code;
 }
 
+// The command the arguments name when it is not one of `app`'s ("" when
+// they name a known one, or none): the first argument that is neither an
+// option of zebrageo itself nor the value of one.
+std::string UnknownCommand(const CLI::App& app, int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--log-level" || arg == "-v" || arg == "--verbosity") {
+      ++i;
+      continue;
+    }
+    if (arg.empty() || arg[0] == '-') continue;
+    try {
+      app.get_subcommand(arg);
+      return "";
+    } catch (const CLI::OptionNotFound&) {
+      return arg;
+    }
+  }
+  return "";
+}
+
+std::string CommandNames(const CLI::App& app) {
+  std::string names;
+  for (const CLI::App* sub :
+       app.get_subcommands([](const CLI::App*) { return true; })) {
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  }
+  return names;
+}
+
 int Main(int argc, char** argv) {
   CLI::App app{
       "zebrageo " ZEBRAGEO_VERSION_STRING
@@ -41,6 +71,9 @@ int Main(int argc, char** argv) {
       "crossings as ground control points."};
   app.set_version_flag("--version", "zebrageo " ZEBRAGEO_VERSION_STRING);
   app.require_subcommand(1);
+  // Options of zebrageo itself (--log-level, -v) after the command's name
+  // too: the subcommands, which inherit this, pass them up.
+  app.fallthrough();
   std::string log_level = "info";
   int verbosity = 0;
   app.add_option("--log-level", log_level, "error, warning, info or debug")
@@ -67,6 +100,12 @@ int Main(int argc, char** argv) {
   AddExportGcpCommand(&app, &commands);
   AddServeCommand(&app, &commands);
 
+  const std::string unknown = UnknownCommand(app, argc, argv);
+  if (!unknown.empty()) {
+    return Fail(kExitUsage, "unknown command '" + unknown +
+                                "'; the commands are: " + CommandNames(app) +
+                                " (zebrageo --help describes them)");
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
