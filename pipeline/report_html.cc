@@ -20,7 +20,7 @@ using nlohmann::json;
 std::string JsonCell(const json& value) {
   if (value.is_number_float()) return FormatFixed(value.get<double>(), 3);
   if (value.is_string()) return EscapeHtml(value.get<std::string>());
-  if (value.is_null()) return "";
+  if (value.is_null()) return "–";
   return EscapeHtml(value.dump());
 }
 
@@ -61,14 +61,18 @@ std::string KeyValueTable(const json& object, const std::string& unit = "") {
   for (const auto& [key, value] : object.items()) {
     if (value.is_object()) {
       // {"unit": "px", "before": ...}: the unit of the object's figures.
-      const std::string sub_unit = value.value("unit", std::string());
+      // "check_rmse_m": {"horizontal": ...}: the unit of the key's figures.
+      const auto [stem, key_unit] = SplitUnit(key);
+      const std::string sub_unit = value.value("unit", key_unit);
       for (const auto& [sub_key, sub_value] : value.items()) {
         if (sub_value.is_object() || sub_value.is_array() ||
             sub_key == "unit") {
           continue;
         }
-        std::string header = HumanKey(key + "_" + sub_key);
-        if (!sub_unit.empty() && sub_value.is_number_float()) {
+        std::string header = HumanKey(stem + "_" + sub_key);
+        if (!sub_unit.empty() &&
+            (sub_value.is_number_float() || sub_value.is_null()) &&
+            header.find('(') == std::string::npos) {
           header += " (" + sub_unit + ")";
         }
         html << "<tr><th>" << EscapeHtml(header) << "</th><td>"
@@ -349,7 +353,7 @@ std::string RenderHtml(const json& report, const ReportData& data) {
                    "least as well as the input trajectory does.")
          << " Each crossing's distance from the database, placed with "
             "each trajectory:</p>\n"
-         << ArrayTable(guard["crossings"]);
+         << GuardTable(guard["crossings"]);
   }
 
   html << "<h2>Trajectory</h2>\n"

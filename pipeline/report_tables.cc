@@ -21,7 +21,10 @@ constexpr char kControlColour[] = "#1f77b4";
 constexpr char kCheckColour[] = "#d62728";
 
 std::string Cell(double value, int decimals) {
-  return std::isfinite(value) ? FormatFixed(value, decimals) : "–";
+  if (!std::isfinite(value)) return "–";
+  // -0.04 shown to 1 decimal is 0.0, not -0.0.
+  const double unit = std::pow(10.0, -decimals);
+  return FormatFixed(std::abs(value) < 0.5 * unit ? 0.0 : value, decimals);
 }
 
 // A row of <td>s (or <th>s).
@@ -62,10 +65,24 @@ std::string RmsChart(
     const std::string& unit,
     const std::vector<std::tuple<std::string, double, double>>& rows) {
   constexpr int kRowPx = 44, kLabelPx = 230, kBarPx = 440, kWidthPx = 860;
-  double top = 1e-12;
+  double largest = 1e-12;
   for (const auto& [type, before, after] : rows) {
-    top = std::max({top, before, after});
+    largest = std::max({largest, before, after});
   }
+  // The axis ends at a round number: 4 ticks of 1, 2, 2.5 or 5 x 10^k.
+  const double power = std::pow(10.0, std::floor(std::log10(largest / 4)));
+  double step = 10.0 * power;
+  for (double factor : {1.0, 2.0, 2.5, 5.0}) {
+    if (4 * factor * power >= largest) {
+      step = factor * power;
+      break;
+    }
+  }
+  const double top = 4 * step;
+  // Decimals of the step (2.5 x 10^k needs one more than 10^k).
+  const int decimals =
+      std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)) +
+                      (std::fmod(step / power + 1e-9, 1.0) > 0.1 ? 1 : 0));
   std::ostringstream bars;
   int n = 0;
   for (const auto& [type, before, after] : rows) {
@@ -106,10 +123,7 @@ std::string RmsChart(
     svg << "<line x1='" << x << "' y1='" << axis_y << "' x2='" << x << "' y2='"
         << axis_y + 4 << "' stroke='#333'/><text x='" << x << "' y='"
         << axis_y + 16 << "' text-anchor='middle'>"
-        << FormatFixed(top * i / 4.0, top < 0.1  ? 4
-                                      : top < 10 ? 2
-                                                 : 1)
-        << "</text>";
+        << FormatFixed(step * i, decimals) << "</text>";
   }
   svg << "<text x='" << kLabelPx + kBarPx / 2 << "' y='" << axis_y + 30
       << "' text-anchor='middle'>RMS (" << EscapeHtml(unit) << ")</text>\n"
@@ -119,21 +133,22 @@ std::string RmsChart(
 
 }  // namespace
 
-std::string HumanKey(const std::string& key) {
+std::pair<std::string, std::string> SplitUnit(const std::string& key) {
   static const std::vector<std::pair<std::string, std::string>> kUnits = {
       {"_m2", "m²"}, {"_cm", "cm"}, {"_mm", "mm"},   {"_m", "m"},
       {"_s", "s"},   {"_deg", "°"}, {"_px", "px"},   {"_mb", "MB"},
       {"_hz", "Hz"}, {"_sd", "sd"}, {"_ppm", "ppm"}, {"_pct", "%"}};
-  std::string stem = key, unit;
   for (const auto& [suffix, name] : kUnits) {
-    if (stem.size() > suffix.size() &&
-        stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0) {
-      stem.resize(stem.size() - suffix.size());
-      unit = name;
-      break;
+    if (key.size() > suffix.size() &&
+        key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      return {key.substr(0, key.size() - suffix.size()), name};
     }
   }
-  if (key == "z") unit = "sd";
+  return {key, key == "z" ? "sd" : ""};
+}
+
+std::string HumanKey(const std::string& key) {
+  const auto [stem, unit] = SplitUnit(key);
   std::string words;
   std::istringstream parts(stem);
   std::string part;
@@ -268,6 +283,31 @@ std::string CameraResidualSection(const ReportData& data) {
                             "observations");
   }
   html << "</div></div>\n";
+  return html.str();
+}
+
+std::string GuardTable(const json& crossings) {
+  std::ostringstream html;
+  html << "<table>"
+       << Row({"Crossing", "Used as control or check", "Input misfit (cm)",
+               "Adjusted misfit (cm)", "Adjusted worse by (sd)",
+               "Adjusted worse"},
+              true);
+  for (const json& c : crossings) {
+    const auto cm = [&c](const char* key) {
+      return c.contains(key) && c[key].is_number()
+                 ? Cell(100.0 * c[key].get<double>(), 1)
+                 : std::string("–");
+    };
+    html << Row({EscapeHtml(c.value("crossing_id", std::string())),
+                 c.value("used", false) ? "yes" : "no (rejected)",
+                 cm("input_misfit_m"), cm("adjusted_misfit_m"),
+                 c.contains("z") && c["z"].is_number()
+                     ? Cell(c["z"].get<double>(), 1)
+                     : std::string("–"),
+                 c.value("worse", false) ? "<b>yes</b>" : "no"});
+  }
+  html << "</table>\n";
   return html.str();
 }
 

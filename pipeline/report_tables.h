@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "pipeline/report_data.h"
 
@@ -15,6 +16,13 @@ namespace report_internal {
 // A column header from a report.json key: words, and the unit its suffix
 // names in brackets ("rmse_horizontal_m" -> "RMSE horizontal (m)").
 std::string HumanKey(const std::string& key);
+// A key's stem and the unit its suffix names ("max_3d_m" -> "max_3d", "m");
+// no unit: the key and "".
+std::pair<std::string, std::string> SplitUnit(const std::string& key);
+
+// The comparison with the input trajectory (report.json adjustment.guard
+// crossings): per crossing, both misfits in cm and the evidence in sd.
+std::string GuardTable(const nlohmann::json& crossings);
 
 // Control and check points side by side: crossings, vertices, RMSE
 // horizontal, vertical and 3D and the largest residual, in cm.
