@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
+#include <string>
 
 #include "pipeline/exit_codes.h"
 #include "pipeline/pipeline.h"
@@ -58,6 +60,35 @@ RunOptions OptionsOf(const RunArguments& args) {
   return options;
 }
 
+// The run's closing line: where the results are and the headline figure
+// (the check points' RMSE, the honest one, else the control points').
+std::string ResultLine(const std::string& results,
+                       const nlohmann::json& report) {
+  std::ostringstream line;
+  line.setf(std::ios::fixed);
+  line.precision(1);
+  line << "done: " << results << " (" << kReportHtmlFile
+       << "): " << report["counts"].value("matched_crossings", 0)
+       << " crossings matched";
+  for (const char* role : {"check", "control"}) {
+    const nlohmann::json& g = report.value("gcp", nlohmann::json::object())
+                                  .value(role, nlohmann::json::object());
+    if (!g.contains("rmse_horizontal_m") ||
+        !g["rmse_horizontal_m"].is_number()) {
+      continue;
+    }
+    line << "; " << role << " points RMSE horizontal "
+         << 100.0 * g["rmse_horizontal_m"].get<double>() << " cm, vertical "
+         << 100.0 * g["rmse_vertical_m"].get<double>() << " cm ("
+         << g.value("crossings", 0) << " crossings)";
+    break;
+  }
+  const size_t warnings =
+      report.value("warnings", nlohmann::json::array()).size();
+  if (warnings > 0) line << "; " << warnings << " warnings (above)";
+  return line.str();
+}
+
 void Run(const RunArguments& args) {
   const RunOptions options = OptionsOf(args);
   if (args.print_options) {
@@ -86,8 +117,7 @@ void Run(const RunArguments& args) {
     LOG(WARNING) << warning.get<std::string>();
   }
   session.Succeeded();
-  std::cout << "report: " << args.stage.results << "/" << kReportHtmlFile
-            << "\n";
+  std::cout << ResultLine(args.stage.results, run.report) << "\n";
 }
 
 // `report` reads a results folder: one without a stage's output (a typo, a

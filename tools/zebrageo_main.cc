@@ -15,12 +15,15 @@
 #include "survey/cancellation.h"
 #include "survey/input_error.h"
 #include "tools/commands.h"
+#include "tools/progress_bars.h"
 
 namespace zebrageo {
 namespace {
 
 void ConfigureLogging(const std::string& level, int verbosity) {
-  FLAGS_logtostderr = true;
+  // Lines on their own, never glued to a progress bar; glog's prefix with
+  // the source file and line for debug only.
+  LogToConsole(level == "debug");
   FLAGS_colorlogtostderr = false;
   if (level == "error") FLAGS_minloglevel = google::GLOG_ERROR;
   if (level == "warning") FLAGS_minloglevel = google::GLOG_WARNING;
