@@ -255,8 +255,10 @@ class HostileSurvey : public ::testing::Test {
         nlohmann::json::parse(ReadWholeFile(results + "/report.json"));
     for (const nlohmann::json& w : report.at("warnings")) warnings.push_back(w);
     std::istringstream lines(err);
+    // zebrageo's console format ("12:24:26 warning: text"), or glog's
+    // (--log-level debug).
     const std::regex glog_warning(
-        R"(^W[0-9]{8} [0-9:.]+ +[0-9]+ [^\]]+\] (.*)$)");
+        R"(^(?:[0-9]{2}:[0-9]{2}:[0-9]{2} warning: |W[0-9]{8} [0-9:.]+ +[0-9]+ [^\]]+\] )(.*)$)");
     for (std::string line; std::getline(lines, line);) {
       std::smatch match;
       if (!std::regex_match(line, match, glog_warning)) continue;
