@@ -1,6 +1,7 @@
 #include "pipeline/adjust_outputs.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <set>
@@ -234,7 +235,14 @@ ColmapModel ColmapModelOf(const AdjustmentData& data,
   model.camera_notes = {
       "zebrageo rig cameras; FULL_OPENCV fx fy cx cy k1 k2 p1 p2 k3 k4 k5 k6 "
       "(cx, cy + 0.5: COLMAP pixel centres)"};
-  model.image_notes = {"World frame: the survey's ENU frame (metres)."};
+  char origin[160];
+  std::snprintf(origin, sizeof(origin),
+                "World frame: the survey's ENU frame (metres), origin at "
+                "latitude %.9f, longitude %.9f degrees, height %.4f m "
+                "(WGS84 ellipsoidal).",
+                data.frame.origin().lat_deg, data.frame.origin().lon_deg,
+                data.frame.origin().h_m);
+  model.image_notes = {origin};
   const Rig& rig = data.rig;
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
     const Camera& camera = rig.cameras[c].camera;
@@ -264,16 +272,22 @@ ColmapModel ColmapModelOf(const AdjustmentData& data,
   for (const CameraPose& pose : result.camera_poses) {
     pose_of[{pose.exposure_id, pose.camera}] = &pose;
   }
+  std::vector<const CameraPose*> image_pose(data.exposures.images.size());
   for (size_t i = 0; i < data.exposures.images.size(); ++i) {
     const ExposureImage& image = data.exposures.images[i];
     const auto pose = pose_of.find(
         {image.exposure_id, rig.cameras[image.camera].camera.name()});
-    if (pose == pose_of.end()) continue;
+    if (pose != pose_of.end()) image_pose[i] = pose->second;
+  }
+  for (size_t i = 0; i < data.exposures.images.size(); ++i) {
+    const ExposureImage& image = data.exposures.images[i];
+    const CameraPose* const pose = image_pose[i];
+    if (pose == nullptr) continue;
     ColmapImage colmap;
     colmap.id = static_cast<int64_t>(i + 1);
     // COLMAP stores cam_from_world.
-    colmap.q = pose->second->q_enu_cam.conjugate();
-    colmap.t = -(colmap.q * pose->second->p_enu);
+    colmap.q = pose->q_enu_cam.conjugate();
+    colmap.t = -(colmap.q * pose->p_enu);
     colmap.camera_id = image.camera + 1;
     colmap.name = image.image;
     for (const auto& [uv, point] : observations.image_points[i]) {
@@ -285,9 +299,24 @@ ColmapModel ColmapModelOf(const AdjustmentData& data,
     ColmapPoint3D point;
     point.id = static_cast<int64_t>(p + 1);
     point.X = points[p].X;
+    // COLMAP's ERROR: the mean reprojection error of the track, pixels.
+    double error_sum = 0.0;
+    int error_count = 0;
     for (const auto& [image, index] : observations.tracks[p]) {
       point.track.emplace_back(image + 1, index);
+      const CameraPose* pose = image_pose[image];
+      if (pose == nullptr) continue;
+      const Camera& camera =
+          rig.cameras[data.exposures.images[image].camera].camera;
+      Eigen::Vector2d uv;
+      if (camera.Project(pose->q_enu_cam.conjugate() * (point.X - pose->p_enu),
+                         &uv)) {
+        error_sum +=
+            (uv - observations.image_points[image][index].first).norm();
+        ++error_count;
+      }
     }
+    point.error = error_count > 0 ? error_sum / error_count : 0.0;
     model.points.push_back(std::move(point));
   }
   return model;

@@ -4,9 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
+#include "geodata/colmap_export.h"
 #include "pipeline/adjustment_pass.h"
 #include "survey/input_error.h"
 #include "survey/results.h"
@@ -56,6 +63,29 @@ TEST(AdjustStage, WritesEveryContractOutputReadableByTheSurveyReaders) {
         folder.Path(std::string("results/") + name)))
         << name;
   }
+  // The COLMAP model: each point's ERROR is its track's mean reprojection
+  // error (it was written as 0), images.txt names the local frame's
+  // origin.
+  const ColmapModel colmap = ReadColmapModel(folder.Path("results/colmap"));
+  std::vector<double> errors;
+  for (const ColmapPoint3D& point : colmap.points) {
+    if (point.track.empty()) continue;
+    EXPECT_TRUE(std::isfinite(point.error));
+    errors.push_back(point.error);
+  }
+  ASSERT_FALSE(errors.empty());
+  std::sort(errors.begin(), errors.end());
+  const double median_px = errors[errors.size() / 2];
+  EXPECT_GT(median_px, 0.01);
+  EXPECT_LT(median_px, 2.0);
+  std::ifstream images(folder.Path("results/colmap/images.txt"));
+  const std::string images_text((std::istreambuf_iterator<char>(images)),
+                                std::istreambuf_iterator<char>());
+  char origin[64];
+  std::snprintf(origin, sizeof(origin), "latitude %.9f",
+                loaded.frame.origin().lat_deg);
+  EXPECT_NE(images_text.find(origin), std::string::npos)
+      << images_text.substr(0, 400);
   // report.json is the report stage's.
   EXPECT_FALSE(std::filesystem::exists(folder.Path("results/report.json")));
 }
