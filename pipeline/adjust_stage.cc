@@ -3,6 +3,8 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <utility>
@@ -13,6 +15,8 @@
 #include "pipeline/exit_codes.h"
 #include "pipeline/rematch_stage.h"
 #include "survey/atomic_file.h"
+#include "survey/image_io.h"
+#include "survey/input_error.h"
 #include "survey/output_crs.h"
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
@@ -67,19 +71,43 @@ struct AdjustState {
   std::vector<std::string> warnings;
 };
 
-// Exposures the reconstruction skipped (their images could not be read):
-// they get no pose (SURVEY_FORMAT.md).
-void DropSkippedExposures(StageResults* results, AdjustmentResult* result) {
-  std::set<int64_t> skipped;
+// The images of the exposures the reconstruction skipped that cannot be
+// read (SURVEY_FORMAT.md: only they may lack a pose): the image its reason
+// names, or whose header does not read. The other camera of an exposure
+// whose right image is missing keeps its pose.
+void DropUnreadableImages(const Survey& survey, StageResults* results,
+                          AdjustmentResult* result) {
+  std::map<int64_t, std::string> reasons;
   for (const SkippedExposure& s : results->SkippedExposures()) {
-    skipped.insert(s.exposure_id);
+    reasons[s.exposure_id] = s.reason;
+  }
+  std::set<std::pair<int64_t, std::string>> unreadable;
+  for (const ExposureImage& image : survey.exposures.images) {
+    const auto reason = reasons.find(image.exposure_id);
+    if (reason == reasons.end()) continue;
+    bool readable = reason->second.find(image.image) == std::string::npos;
+    if (readable) {
+      try {
+        ReadImageHeader(
+            (std::filesystem::path(survey.folder) / image.image).string(),
+            image.image);
+      } catch (const InputError&) {
+        readable = false;
+      }
+    }
+    if (!readable) {
+      unreadable.insert(
+          {image.exposure_id, survey.rig.cameras[image.camera].camera.name()});
+    }
   }
   auto& poses = result->camera_poses;
-  poses.erase(std::remove_if(poses.begin(), poses.end(),
-                             [&skipped](const CameraPose& pose) {
-                               return skipped.count(pose.exposure_id) > 0;
-                             }),
-              poses.end());
+  poses.erase(
+      std::remove_if(
+          poses.begin(), poses.end(),
+          [&unreadable](const CameraPose& pose) {
+            return unreadable.count({pose.exposure_id, pose.camera}) > 0;
+          }),
+      poses.end());
 }
 
 // "adjust needs a usable result": the solver's message names no input, so
@@ -120,7 +148,7 @@ void Adjust(const Survey& survey, StageResults* results, const TiePoints& ties,
                            pass.lines->warnings.end());
     if (pass.lines->record) state->lines = pass.lines;
   }
-  DropSkippedExposures(results, &pass.result);
+  DropUnreadableImages(survey, results, &pass.result);
   state->record = AdjustmentRecordOf(data, options.adjustment, pass.result,
                                      ties.used ? &ties.summary : nullptr);
   std::string crossings;

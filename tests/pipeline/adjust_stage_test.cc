@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -88,6 +91,50 @@ TEST(AdjustStage, WritesEveryContractOutputReadableByTheSurveyReaders) {
       << images_text.substr(0, 400);
   // report.json is the report stage's.
   EXPECT_FALSE(std::filesystem::exists(folder.Path("results/report.json")));
+}
+
+// An exposure the reconstruction skipped because its right image is
+// missing: only that image lacks a pose (SURVEY_FORMAT.md), its left
+// camera keeps its own (issue 47: both were dropped).
+TEST(AdjustStage, ExposureWithoutItsRightImageKeepsItsLeftPose) {
+  const SyntheticSurvey survey = MakeSyntheticSurvey(KilometreOptions());
+  TemporaryFolder folder;
+  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
+  SurveyLoadOptions load_options;
+  load_options.require_images = false;
+  const Survey loaded = LoadSurvey(folder.Path("survey"), load_options);
+  const Exposure& exposure = loaded.exposures.exposures.at(10);
+  const std::array<int, 2> pair = loaded.rig.stereo_pairs.at(0);
+  const ExposureImage& left =
+      loaded.exposures.images.at(exposure.image_of_camera[pair[0]]);
+  const ExposureImage& right =
+      loaded.exposures.images.at(exposure.image_of_camera[pair[1]]);
+  // The left image is there and readable; the right one is not.
+  const std::filesystem::path left_path =
+      std::filesystem::path(folder.Path("survey")) / left.image;
+  std::filesystem::create_directories(left_path.parent_path());
+  ASSERT_TRUE(
+      cv::imwrite(left_path.string(), cv::Mat(8, 8, CV_8UC1, cv::Scalar(0))));
+  WriteSkippedExposures(
+      {{exposure.exposure_id,
+        "exposure " + std::to_string(exposure.exposure_id) + ": " +
+            right.image + ": image file does not exist: exposure skipped"}},
+      folder.Path("results/skipped_exposures.csv"));
+  StageResults results(folder.Path("results"));
+  RunOptions options;
+  options.tie_points = false;
+  options.rematch = false;
+  RunAdjustStage(loaded, &results, options);
+  std::set<std::string> cameras;
+  size_t rows = 0;
+  for (const CameraPose& pose :
+       ReadCameraPoses(folder.Path("results/poses.csv"), "poses.csv")) {
+    ++rows;
+    if (pose.exposure_id == exposure.exposure_id) cameras.insert(pose.camera);
+  }
+  EXPECT_EQ(cameras,
+            (std::set<std::string>{loaded.rig.cameras[pair[0]].camera.name()}));
+  EXPECT_EQ(rows, loaded.exposures.images.size() - 1);
 }
 
 TEST(AdjustStage, MissingStageOutputsNameTheStageToRun) {
