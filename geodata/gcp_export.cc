@@ -163,6 +163,10 @@ std::vector<GroundControlPoint> CollectGroundControlPoints(
       if (image == nullptr || !observed.insert({key, image->image}).second) {
         continue;
       }
+      // A corner the reconstruction extrapolated past the image's edge
+      // (-5.1 px on the demo) is no observation an importer accepts.
+      const Eigen::Vector2d& uv = side == 0 ? v.uv_left : v.uv_right;
+      if (!survey.rig.cameras[camera].camera.IsInImage(uv)) continue;
       GcpObservation observation;
       observation.exposure_id = v.exposure_id;
       observation.camera = survey.rig.cameras[camera].camera.name();
@@ -185,9 +189,12 @@ std::vector<GroundControlPoint> CollectGroundControlPoints(
 }
 
 GcpCoordinateSystem Wgs84GcpCoordinates() {
-  return {"EPSG:4326", [](const Geodetic& g) {
+  return {"EPSG:4326",
+          [](const Geodetic& g) {
             return Eigen::Vector3d(g.lon_deg, g.lat_deg, g.h_m);
-          }};
+          },
+          "EPSG:4326 (WGS 84: longitude, latitude in degrees, ellipsoidal "
+          "height in metres)"};
 }
 
 GcpCoordinates GcpCoordinatesFor(const std::string& definition,
@@ -225,9 +232,14 @@ GcpCoordinates GcpCoordinatesFor(const std::string& definition,
   CrsOptions options;
   options.grid_dirs = grid_dirs;
   auto transformer = std::make_shared<CrsTransformer>(crs, options);
+  // Every export names the CRS, a compound one too (its header may not).
+  const std::string name =
+      (crs.identifier().empty() ? crs_definition : crs.identifier()) + " (" +
+      crs.Description() + ")";
   return {
       {header,
-       [transformer](const Geodetic& g) { return transformer->FromWgs84(g); }},
+       [transformer](const Geodetic& g) { return transformer->FromWgs84(g); },
+       name},
       crs_definition};
 }
 
@@ -297,7 +309,7 @@ void WriteMetashapeMarkers(const std::vector<GroundControlPoint>& gcps,
   // written before either is renamed into place: a failure leaves neither.
   AtomicFile markers(path);
   std::ostream& out = markers.stream();
-  out << "# zebrageo ground control; CRS " << crs.header << "\n";
+  out << "# zebrageo ground control; CRS " << crs.name << "\n";
   out << "# label,x,y,z,x_accuracy,y_accuracy,z_accuracy,enabled\n";
   for (const GroundControlPoint& gcp : gcps) {
     const Eigen::Vector3d xyz = crs.from_wgs84(gcp.position);

@@ -92,6 +92,9 @@ std::vector<GroundControlPoint> CollectGroundControlPoints(
 struct GcpCoordinateSystem {
   std::string header;  // "WGS84 UTM 32N", "EPSG:2154", "+proj=...", "WGS84"
   std::function<Eigen::Vector3d(const Geodetic&)> from_wgs84;
+  // The CRS named for people and Metashape, a compound one too:
+  // "EPSG:2154+5720 (RGF93 v1 / Lambert-93 + NGF-IGN69 height)".
+  std::string name;
 };
 // Longitude, latitude (degrees), ellipsoidal height: "EPSG:4326" (ODM
 // reads x, y as longitude, latitude).

@@ -417,6 +417,73 @@ TEST_F(GcpExport, MetashapeReferenceMarksCheckPointsDisabled) {
   EXPECT_EQ(rows, static_cast<int>(roles.size()));
 }
 
+// A compound CRS (projected + geoid heights) has no single EPSG code for
+// gcp_list.txt's header, but Metashape's file still names it (issue 47: its
+// CRS comment was empty).
+TEST_F(GcpExport, MetashapeNamesACompoundCrs) {
+  if (!fs::exists("/usr/share/proj/egm96_15.gtx")) {
+    GTEST_SKIP() << "the EGM96 grid (Debian proj-data) is not installed";
+  }
+  const std::string path = folder_->Path("compound.csv");
+  ASSERT_EQ(Export("--format metashape --crs EPSG:32631+5773", path), 0)
+      << ExportError();
+  const std::string text = ReadWholeFile(path);
+  const std::string first = text.substr(0, text.find('\n'));
+  EXPECT_NE(first.find("CRS EPSG:32631+5773 ("), std::string::npos) << first;
+  EXPECT_NE(first.find("EGM96"), std::string::npos) << first;
+}
+
+// An observation the reconstruction placed outside its image (a band
+// corner extrapolated past the edge: -5.1 px on the demo) is not exported;
+// every exported observation lies on its image.
+TEST_F(GcpExport, ObservationsOutsideTheImageAreLeftOut) {
+  const std::string bands = Results("reconstructed_bands.csv");
+  const std::string original = ReadWholeFile(bands);
+  std::vector<ReconstructedVertex> vertices =
+      ReadReconstructedBands(bands, "reconstructed_bands.csv");
+  const std::vector<VertexMatch> matches =
+      ReadMatches(Results("matches.csv"), "matches.csv");
+  ASSERT_FALSE(matches.empty());
+  const VertexMatch& moved = matches.back();
+  int changed = 0;
+  for (ReconstructedVertex& v : vertices) {
+    if (v.exposure_id == moved.exposure_id && v.band_id == moved.band_id &&
+        v.vertex == moved.vertex) {
+      v.uv_left.x() = -5.1;
+      ++changed;
+    }
+  }
+  ASSERT_EQ(changed, 1);
+  WriteReconstructedBands(vertices, {}, bands);
+  const std::string path = folder_->Path("outside.csv");
+  const int status = Export("--format metashape --include-check", path);
+  {
+    std::ofstream restore(bands, std::ios::binary);
+    restore << original;
+  }
+  ASSERT_EQ(status, 0) << ExportError();
+  const Rig rig = ReadRig(Survey("rig.yaml"), "rig.yaml");
+  std::istringstream in(
+      ReadWholeFile(folder_->Path("outside_projections.csv")));
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> fields;
+    std::istringstream split(line);
+    for (std::string field; std::getline(split, field, ',');) {
+      fields.push_back(field);
+    }
+    ASSERT_EQ(fields.size(), 4u) << line;
+    const double u = std::stod(fields[2]), v = std::stod(fields[3]);
+    EXPECT_GE(u, -0.5) << line;
+    EXPECT_GE(v, -0.5) << line;
+    EXPECT_LE(u, rig.cameras.front().camera.width() - 0.5) << line;
+    EXPECT_LE(v, rig.cameras.front().camera.height() - 0.5) << line;
+    ++rows;
+  }
+  EXPECT_GT(rows, 10);
+}
+
 TEST_F(GcpExport, AFolderWithoutMatchesIsAClearError) {
   TemporaryFolder empty;
   const int status =
