@@ -76,13 +76,14 @@ RunProgress ReadRunProgress(const JobFiles& files) {
   }
   if (complete == static_cast<int>(kStages.size())) progress.stage = "report";
   double within = 0.0;
-  // Within a stage: the run's last progress line in the log, "I... ] step:
+  // Within a stage: the run's last progress line in the log, "HH:MM:SS step:
   // done/total (NN%), S s" (tools/progress_bars.cc, every 10 % when stderr is
-  // not a terminal). The lines of the stage's own name advance the
-  // fraction (the largest: a stage never goes back); the last line names
-  // the step (the tie points inside adjust).
+  // not a terminal; glog's "I... ] step: ..." with --log-level debug). The
+  // lines of the stage's own name advance the fraction (the largest: a stage
+  // never goes back); the last line names the step (the tie points inside
+  // adjust).
   static const std::regex kLine(
-      R"(\] ([A-Za-z][A-Za-z ]*): ([0-9]+)/([0-9]+) \([0-9]+%\))");
+      R"((?:\] |[0-9]{2}:[0-9]{2}:[0-9]{2} )([A-Za-z][A-Za-z ]*): ([0-9]+)/([0-9]+) \([0-9]+%\))");
   const std::string tail = LogTail(files.Log(), 40, 1 << 16);
   for (std::sregex_iterator it(tail.begin(), tail.end(), kLine), end; it != end;
        ++it) {

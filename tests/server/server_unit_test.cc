@@ -179,6 +179,14 @@ TEST(RunInvocation, ProgressAndErrorAreReadFromTheRunsFiles) {
   EXPECT_EQ(progress.stage, "match");
   EXPECT_EQ(progress.step, "match");
   EXPECT_DOUBLE_EQ(progress.fraction, (1 + 0.5) / 4.0);  // never back
+  // The console's format of `zebrageo --log-level info` (issue 47).
+  folder.Write("log.txt",
+               "01:00:02 match: 10/20 (50%), 0.1 s, ~0.1 s left\n"
+               "01:00:03 warning: a warning\n"
+               "01:00:03 match: 16/20 (80%), 0.2 s, ~0.1 s left\n");
+  progress = ReadRunProgress(files);
+  EXPECT_EQ(progress.step, "match");
+  EXPECT_DOUBLE_EQ(progress.fraction, (1 + 0.8) / 4.0);
   folder.Write("results/run_state.json",
                R"({"stages": {"reconstruct": {"complete": true},
                    "match": {"complete": true}, "adjust": {"complete": true}}})");
