@@ -17,6 +17,7 @@
 #include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -81,6 +82,9 @@ std::vector<GroundControlPoint> CollectGroundControlPoints(
       (fs::path(results_folder) / kReconstructedBandsFile).string();
   const std::string residuals_path =
       (fs::path(results_folder) / kGcpResidualsFile).string();
+  const std::string identity = SurveyIdentity(survey.exposures);
+  CheckStageFileSurvey(matches_path, kMatchesFile, identity);
+  CheckStageFileSurvey(bands_path, kReconstructedBandsFile, identity);
   const std::vector<VertexMatch> matches =
       ReadMatches(matches_path, kMatchesFile);
   std::map<VertexKey, ReconstructedVertex> reconstructed;

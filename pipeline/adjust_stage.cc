@@ -17,6 +17,7 @@
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
 #include "survey/results_lines.h"
+#include "survey/results_survey.h"
 #include "tiepoints/tie_points.h"
 
 namespace zebrageo {
@@ -187,12 +188,15 @@ void WriteAdjustStage(const Survey& survey, const AdjustState& state,
     WriteLineControl(*state.lines->record, path(kLineControlFile));
   }
   if (state.matches_comments) {
-    WriteMatches(state.matches, *state.matches_comments, path(kMatchesFile),
-                 crs.get());
+    WriteMatches(state.matches,
+                 WithSurveyIdentity(survey.exposures, *state.matches_comments),
+                 path(kMatchesFile), crs.get());
   }
   if (state.decisions_comments) {
-    WriteCrossingDecisions(state.decisions, *state.decisions_comments,
-                           path(kCrossingDecisionsFile));
+    WriteCrossingDecisions(
+        state.decisions,
+        WithSurveyIdentity(survey.exposures, *state.decisions_comments),
+        path(kCrossingDecisionsFile));
   }
   // The trajectory and the poses last: their presence means the stage
   // finished.

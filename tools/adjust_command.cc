@@ -11,6 +11,7 @@
 #include "pipeline/results_session.h"
 #include "pipeline/run_options.h"
 #include "survey/math_util.h"
+#include "survey/results_survey.h"
 #include "tools/commands.h"
 #include "tools/progress_bars.h"
 
@@ -49,8 +50,10 @@ void RunAdjust(const AdjustArguments& args) {
   SurveyLoadOptions load_options = LoadOptionsOf(args.stage);
   load_options.require_images = false;
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
+  const std::string survey_identity = SurveyIdentity(survey.exposures);
+  session.RefuseAnotherSurvey(survey_identity);
   session.Open();
-  StageResults results(args.stage.results);
+  StageResults results(args.stage.results, survey_identity);
   const auto start = std::chrono::steady_clock::now();
   ReportInputs inputs;
   inputs.warnings = RunAdjustStage(survey, &results, options, ProgressBars(),

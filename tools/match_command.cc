@@ -11,6 +11,7 @@
 #include "pipeline/rematch_stage.h"
 #include "pipeline/results_session.h"
 #include "pipeline/run_options.h"
+#include "survey/results_survey.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
 #include "tools/progress_bars.h"
@@ -24,8 +25,10 @@ void RunMatch(const StageArguments& args, const RunOptions& options,
   if (!problem.empty()) throw UsageError("match: " + problem);
   ResultsSession session(args.results, ResultsSession::OnError::kKeepOutputs);
   const Survey survey = LoadSurvey(args.survey, LoadOptionsOf(args));
+  const std::string survey_identity = SurveyIdentity(survey.exposures);
+  session.RefuseAnotherSurvey(survey_identity);
   session.Open();
-  StageResults results(args.results);
+  StageResults results(args.results, survey_identity);
   if (second_pass) {
     const RematchSummary summary =
         RunRematchStage(survey, &results, options, CancelOnSignal());
