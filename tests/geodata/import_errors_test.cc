@@ -108,6 +108,30 @@ TEST_F(ImportErrors, NonFiniteMountNumbersAreUsageErrorsNamingTheOption) {
                 2, {"--pitch-down-deg", "--mount-pitch-deg"});
 }
 
+TEST_F(ImportErrors, NonFiniteImportAndInitNumbersAreUsageErrors) {
+  for (const char* value : {"nan", "inf", "-1", "0"}) {
+    ExpectRefused("import-kalibr " + Quote(camchain_) + " --max-fit-error-px " +
+                      value + Out("rig.yaml"),
+                  2, {"--max-fit-error-px"});
+    ExpectRefused("import-ros-camera-info " + Quote(left_) + " " +
+                      Quote(right_) + " --max-fit-error-px " + value +
+                      Out("rig.yaml"),
+                  2, {"--max-fit-error-px"});
+  }
+  const std::string init =
+      "init " + Quote(tmp_.Path("out/survey")) + " --images " +
+      Quote(tmp_.Path("in")) + " --trajectory " + Quote(random_) +
+      " --calibration " + Quote(camchain_) + " --roadmarks " + Quote(random_);
+  ExpectRefused(init + " --max-fit-error-px nan", 2,
+                {"--max-fit-error-px", "'nan' is not a finite number"});
+  ExpectRefused(init + " --pair-max-dt nan", 2,
+                {"--pair-max-dt", "'nan' is not a finite number"});
+  ExpectRefused(init + " --exif-utc-offset inf", 2,
+                {"--exif-utc-offset", "'inf' is not a finite number"});
+  ExpectRefused(init + " --lever-arm 0 nan 0", 2,
+                {"--lever-arm", "'nan' is not a finite number"});
+}
+
 TEST_F(ImportErrors, AMissingOrMismatchedCameraNamesTheFileAndKey) {
   const std::string mono =
       tmp_.Write("in/mono.yaml", Camchain("[1280, 960]", false));
