@@ -157,9 +157,10 @@ bool Rematch(const Survey& survey, StageResults* results,
   adjusted.line_control_times = state->pass.line_control_times;
   adjusted.fitted_line_times = state->pass.fitted_line_times;
   adjusted.rejected_crossings = RejectedCrossings(state->pass.result);
-  RematchSummary rematch = RematchStep(
-      survey, options, adjusted, results->Vertices(), state->matches,
-      state->decisions, results->LinePoints(), cancel);
+  RematchSummary rematch =
+      RematchStep(survey, options, adjusted, results->Vertices(),
+                  state->matches, state->decisions,
+                  options.lines ? results->LinePoints() : nullptr, cancel);
   LOG(INFO) << rematch.message;
   // Logged as a warning, so listed in report.json too.
   if (rematch.disagreements > 0) refusals->push_back(rematch.message);

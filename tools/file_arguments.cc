@@ -40,6 +40,28 @@ CLI::Validator OutputFileValidator() {
       "FILE");
 }
 
+CLI::Validator OutputFolderValidator() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        namespace fs = std::filesystem;
+        std::error_code error;
+        // The nearest part of the path that exists must be a folder.
+        for (fs::path p = path; !p.empty(); p = p.parent_path()) {
+          const fs::file_status status = fs::status(p, error);
+          if (!fs::exists(status)) {
+            if (p == p.parent_path()) break;
+            continue;
+          }
+          if (fs::is_directory(status)) return "";
+          return p.string() == path ? path + " is a file, not a folder"
+                                    : p.string() + " is a file: the folder " +
+                                          path + " cannot be created in it";
+        }
+        return "";
+      },
+      "FOLDER");
+}
+
 CLI::Validator FiniteWithin(double limit) { return FiniteIn(-limit, limit); }
 
 CLI::Validator FiniteIn(double low, double high, bool above_low) {

@@ -18,6 +18,10 @@ namespace zebrageo {
 // exists (written atomically there: nothing half-written on failure).
 CLI::Validator OutputFileValidator();
 
+// A folder the command creates (or fills): not a file, and no file where
+// one of its missing parents would be created.
+CLI::Validator OutputFolderValidator();
+
 // A finite number within [-limit, limit] ("nan", "inf" and typos refused).
 CLI::Validator FiniteWithin(double limit);
 // A finite number within [low, high], or (low, high] when `above_low`.

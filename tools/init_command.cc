@@ -211,7 +211,8 @@ void AddInitCommand(CLI::App* app, std::vector<Command>* commands) {
           "--time-clock unix) get GPS - UTC from the leap seconds. ") +
       kMountHelp);
   sub->add_option("survey", args->survey, "survey folder to create")
-      ->required();
+      ->required()
+      ->check(OutputFolderValidator());
   sub->add_option("--images", args->images, "folder of the images")
       ->required()
       ->check(CLI::ExistingDirectory);

@@ -130,6 +130,12 @@ TEST_F(ImportErrors, NonFiniteImportAndInitNumbersAreUsageErrors) {
                 {"--exif-utc-offset", "'inf' is not a finite number"});
   ExpectRefused(init + " --lever-arm 0 nan 0", 2,
                 {"--lever-arm", "'nan' is not a finite number"});
+  // The survey folder: not a file, nor inside one.
+  const std::string args = init.substr(init.find(" --images"));
+  ExpectRefused("init " + Quote(camchain_) + args, 2,
+                {"survey: ", "camchain.yaml is a file, not a folder"});
+  ExpectRefused("init " + Quote(camchain_ + "/survey") + args, 2,
+                {"camchain.yaml is a file: the folder", "cannot be created"});
 }
 
 TEST_F(ImportErrors, AMissingOrMismatchedCameraNamesTheFileAndKey) {
