@@ -83,8 +83,8 @@ std::vector<GroundControlPoint> CollectGroundControlPoints(
   const std::string residuals_path =
       (fs::path(results_folder) / kGcpResidualsFile).string();
   const std::string identity = SurveyIdentity(survey.exposures);
-  CheckStageFileSurvey(matches_path, kMatchesFile, identity);
-  CheckStageFileSurvey(bands_path, kReconstructedBandsFile, identity);
+  CheckStageFileSurvey(matches_path, identity);
+  CheckStageFileSurvey(bands_path, identity);
   const std::vector<VertexMatch> matches =
       ReadMatches(matches_path, kMatchesFile);
   std::map<VertexKey, ReconstructedVertex> reconstructed;

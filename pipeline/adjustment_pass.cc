@@ -125,11 +125,11 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
   const std::string identity = SurveyIdentity(data.exposures);
   const std::string bands_path =
       RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct");
-  CheckStageFileSurvey(bands_path, kReconstructedBandsFile, identity);
+  CheckStageFileSurvey(bands_path, identity);
   data.vertices = ReadReconstructedBands(bands_path, kReconstructedBandsFile);
   const std::string matches_path =
       RequiredStageFile(results_folder, kMatchesFile, "match");
-  CheckStageFileSurvey(matches_path, kMatchesFile, identity);
+  CheckStageFileSurvey(matches_path, identity);
   data.matches = ReadMatches(matches_path, kMatchesFile);
   return data;
 }

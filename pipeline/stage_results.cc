@@ -31,9 +31,8 @@ StageResults::StageResults(std::string folder, std::string survey_identity)
     : folder_(std::move(folder)),
       survey_identity_(std::move(survey_identity)) {}
 
-std::string StageResults::SurveyFile(const std::string& path,
-                                     const char* name) const {
-  CheckStageFileSurvey(path, name, survey_identity_);
+std::string StageResults::SurveyFile(const std::string& path) const {
+  CheckStageFileSurvey(path, survey_identity_);
   return path;
 }
 
@@ -61,8 +60,7 @@ std::string RequiredFile(const StageResults& results, const char* name,
 const std::vector<ReconstructedVertex>& StageResults::Vertices() {
   if (!vertices_) {
     vertices_ = ReadReconstructedBands(
-        SurveyFile(RequiredFile(*this, kReconstructedBandsFile, "reconstruct"),
-                   kReconstructedBandsFile),
+        SurveyFile(RequiredFile(*this, kReconstructedBandsFile, "reconstruct")),
         kReconstructedBandsFile);
   }
   return *vertices_;
@@ -82,8 +80,8 @@ const std::vector<ReconstructedLinePoint>* StageResults::LinePoints() {
     const std::string path = PathOf(kReconstructedLinesFile);
     lines_.emplace();
     if (IsFile(path)) {
-      *lines_ = ReadReconstructedLines(
-          SurveyFile(path, kReconstructedLinesFile), kReconstructedLinesFile);
+      *lines_ =
+          ReadReconstructedLines(SurveyFile(path), kReconstructedLinesFile);
     }
   }
   return lines_->has_value() ? &**lines_ : nullptr;
@@ -92,8 +90,7 @@ const std::vector<ReconstructedLinePoint>* StageResults::LinePoints() {
 const std::vector<VertexMatch>& StageResults::Matches() {
   if (!matches_) {
     matches_ = ReadMatches(
-        SurveyFile(RequiredFile(*this, kMatchesFile, "match"), kMatchesFile),
-        kMatchesFile);
+        SurveyFile(RequiredFile(*this, kMatchesFile, "match")), kMatchesFile);
   }
   return *matches_;
 }
@@ -101,9 +98,8 @@ const std::vector<VertexMatch>& StageResults::Matches() {
 const std::vector<CrossingDecision>& StageResults::Decisions() {
   if (!decisions_) {
     const std::string path = PathOf(kCrossingDecisionsFile);
-    decisions_ = IsFile(path) ? ReadCrossingDecisions(
-                                    SurveyFile(path, kCrossingDecisionsFile),
-                                    kCrossingDecisionsFile)
+    decisions_ = IsFile(path) ? ReadCrossingDecisions(SurveyFile(path),
+                                                      kCrossingDecisionsFile)
                               : std::vector<CrossingDecision>();
   }
   return *decisions_;
@@ -138,7 +134,7 @@ void CheckStageFilesBelongTo(const std::string& folder,
   for (const char* name : {kReconstructedBandsFile, kReconstructedLinesFile,
                            kMatchesFile, kCrossingDecisionsFile}) {
     const std::string path = (fs::path(folder) / name).string();
-    if (IsFile(path)) CheckStageFileSurvey(path, name, survey_identity);
+    if (IsFile(path)) CheckStageFileSurvey(path, survey_identity);
   }
 }
 

@@ -60,8 +60,8 @@ class StageResults {
                      AdjustmentRecord record);
 
  private:
-  // folder/name, checked to belong to the survey.
-  std::string SurveyFile(const std::string& path, const char* name) const;
+  // `path`, checked to belong to the survey.
+  std::string SurveyFile(const std::string& path) const;
 
   std::string folder_;
   std::string survey_identity_;

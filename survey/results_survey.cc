@@ -87,19 +87,18 @@ StageFileSurvey ReadStageFileSurvey(const std::string& path,
 }
 
 void CheckStageFileSurvey(const std::string& path,
-                          const std::string& display_name,
                           const std::string& identity) {
   if (identity.empty()) return;
-  const StageFileSurvey file = ReadStageFileSurvey(path, display_name);
+  const StageFileSurvey file = ReadStageFileSurvey(path, path);
   if (file.identity.empty()) {
-    LOG(WARNING) << display_name
+    LOG(WARNING) << path
                  << ": names no survey (written by an older zebrageo): "
                     "read as this survey's; rerun the stage if it is not";
     return;
   }
   if (file.identity != identity) {
     throw InputError(
-        display_name, file.line,
+        path, file.line,
         "belongs to another survey (survey " + file.identity +
             ", this survey's exposures are " + identity +
             "): its exposure ids would name other images. Write this "

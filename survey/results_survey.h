@@ -42,13 +42,11 @@ struct StageFileSurvey {
 StageFileSurvey ReadStageFileSurvey(const std::string& path,
                                     const std::string& display_name);
 
-// Throws InputError("<display_name>:<line>: belongs to another survey ...")
-// when the file names an identity other than `identity`; logs a warning
-// when it names none. Nothing when `identity` is empty (no survey to
-// compare with).
-void CheckStageFileSurvey(const std::string& path,
-                          const std::string& display_name,
-                          const std::string& identity);
+// Throws InputError("<path>:<line>: belongs to another survey ...") when
+// the file names an identity other than `identity`; logs a warning when it
+// names none. Nothing when `identity` is empty (no survey to compare with).
+// The path is named in full: the results folder is what is wrong.
+void CheckStageFileSurvey(const std::string& path, const std::string& identity);
 
 }  // namespace zebrageo
 

@@ -59,16 +59,16 @@ TEST(SurveyIdentity, IsReadBackFromTheWritersComments) {
   const StageFileSurvey file = ReadStageFileSurvey(path, "matches.csv");
   EXPECT_EQ(file.identity, identity);
   EXPECT_EQ(file.line, 1);
-  EXPECT_NO_THROW(CheckStageFileSurvey(path, "matches.csv", identity));
+  EXPECT_NO_THROW(CheckStageFileSurvey(path, identity));
   EXPECT_EQ(ReadMatches(path, "matches.csv").size(), 1u);
 
   ExposureTable other = table;
   other.exposures[1].exposure_id = 7;
   try {
-    CheckStageFileSurvey(path, "matches.csv", SurveyIdentity(other));
+    CheckStageFileSurvey(path, SurveyIdentity(other));
     ADD_FAILURE() << "another survey's file was accepted";
   } catch (const InputError& error) {
-    EXPECT_EQ(error.file(), "matches.csv");
+    EXPECT_EQ(error.file(), path);
     EXPECT_EQ(error.line(), 1);
     EXPECT_NE(error.problem().find("belongs to another survey"),
               std::string::npos)
@@ -82,10 +82,9 @@ TEST(SurveyIdentity, OnlyLeadingCommentsNameIt) {
   const std::string old = tmp.Write(
       "old.csv", "# zebrageo match\nexposure_id,band_id\n# survey: 1234\n");
   EXPECT_EQ(ReadStageFileSurvey(old, "old.csv").identity, "");
-  EXPECT_NO_THROW(CheckStageFileSurvey(old, "old.csv", "00000000000000ff"));
+  EXPECT_NO_THROW(CheckStageFileSurvey(old, "00000000000000ff"));
   // No survey to compare with: not read at all.
-  EXPECT_NO_THROW(
-      CheckStageFileSurvey(tmp.Path("absent.csv"), "absent.csv", ""));
+  EXPECT_NO_THROW(CheckStageFileSurvey(tmp.Path("absent.csv"), ""));
   EXPECT_THROW(ReadStageFileSurvey(tmp.Path("absent.csv"), "absent.csv"),
                InputError);
   // A byte-order mark and blank lines before it.
