@@ -169,7 +169,17 @@ TEST_F(ImportErrors, DevicesAndRandomBytesAreNotTheirFormat) {
     ExpectRefused("import-ros-camera-info " + Quote(input) + " " +
                       Quote(right_) + Out("rig.yaml"),
                   1, {input, "not a ROS camera_info file"});
+    ExpectRefused("import-opencv-stereo " + Quote(input) + Out("rig.yaml"), 1,
+                  {input, "not an OpenCV calibration file"});
   }
+  // Another tool's calibration, and a calibration too large to be one.
+  ExpectRefused("import-opencv-stereo " + Quote(camchain_) + Out("rig.yaml"), 1,
+                {"camchain.yaml: not an OpenCV calibration file",
+                 "OpenCV cannot parse it"});
+  const std::string huge =
+      tmp_.Write("in/huge.yaml", "%YAML:1.0\n" + std::string(2 << 20, ' '));
+  ExpectRefused("import-opencv-stereo " + Quote(huge) + Out("rig.yaml"), 1,
+                {"huge.yaml: not an OpenCV calibration file", "bytes, more"});
   // Text without a NUL byte that is no calibration.
   const std::string text = tmp_.Write("in/notes.txt", "just some notes\n");
   ExpectRefused("import-kalibr " + Quote(text) + Out("rig.yaml"), 1,
