@@ -120,6 +120,20 @@ TEST_F(StageSurvey, AnotherSurveysStageFilesAreRefused) {
   EXPECT_TRUE(FilesUnder(tmp_->Path("out")).empty());
 }
 
+TEST_F(StageSurvey, ExportFromAnEmptyResultsFolderNamesTheMissingFile) {
+  fs::create_directories(tmp_->Path("empty"));
+  fs::create_directories(tmp_->Path("out"));
+  EXPECT_EQ(Run("export-gcp " + Quote(tmp_->Path("survey1")) + " " +
+                Quote(tmp_->Path("empty")) + " --format odm -o " +
+                Quote(tmp_->Path("out/gcp_list.txt"))),
+            1);
+  const std::string named =
+      tmp_->Path("empty/matches.csv") + ": not found: run";
+  EXPECT_NE(Stderr().find(named), std::string::npos) << Stderr();
+  EXPECT_TRUE(FilesUnder(tmp_->Path("out")).empty());
+  EXPECT_TRUE(FilesUnder(tmp_->Path("empty")).empty());
+}
+
 TEST_F(StageSurvey, RenumberedExposuresAreAnotherSurvey) {
   // Survey A with every exposure id moved by 1000: the same images and
   // times, but the stage files' ids now name no exposure, or another one.
