@@ -50,10 +50,10 @@ void RunAdjust(const AdjustArguments& args) {
   SurveyLoadOptions load_options = LoadOptionsOf(args.stage);
   load_options.require_images = false;
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
-  const std::string survey_identity = SurveyIdentity(survey.exposures);
-  session.RefuseAnotherSurvey(survey_identity);
+  // Every stage file the command may read, checked once.
+  session.RefuseAnotherSurvey(SurveyIdentity(survey.exposures));
   session.Open();
-  StageResults results(args.stage.results, survey_identity);
+  StageResults results(args.stage.results);
   const auto start = std::chrono::steady_clock::now();
   ReportInputs inputs;
   inputs.warnings = RunAdjustStage(survey, &results, options, ProgressBars(),

@@ -25,10 +25,10 @@ void RunMatch(const StageArguments& args, const RunOptions& options,
   if (!problem.empty()) throw UsageError("match: " + problem);
   ResultsSession session(args.results, ResultsSession::OnError::kKeepOutputs);
   const Survey survey = LoadSurvey(args.survey, LoadOptionsOf(args));
-  const std::string survey_identity = SurveyIdentity(survey.exposures);
-  session.RefuseAnotherSurvey(survey_identity);
+  // Every stage file the command may read, checked once.
+  session.RefuseAnotherSurvey(SurveyIdentity(survey.exposures));
   session.Open();
-  StageResults results(args.results, survey_identity);
+  StageResults results(args.results);
   if (second_pass) {
     const RematchSummary summary =
         RunRematchStage(survey, &results, options, CancelOnSignal());
