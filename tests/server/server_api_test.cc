@@ -177,7 +177,9 @@ TEST_F(ServerApi,
   const httplib::Result log = client.Get("/jobs/" + ids[0] + "/log?tail=1000");
   ASSERT_TRUE(log);
   EXPECT_NE(log->body.find("zebrageo serve: attempt 1"), std::string::npos);
-  EXPECT_NE(log->body.find("report: "), std::string::npos) << log->body;
+  // The run's closing line (tools/run_command.cc).
+  EXPECT_NE(log->body.find("done: "), std::string::npos) << log->body;
+  EXPECT_NE(log->body.find("(report.html): "), std::string::npos);
   const httplib::Result tail = client.Get("/jobs/" + ids[0] + "/log?tail=2");
   ASSERT_TRUE(tail);
   EXPECT_EQ(std::count(tail->body.begin(), tail->body.end(), '\n'), 2);
