@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "survey/csv.h"
+#include "survey/database_height.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
 #include "survey/option_check.h"
@@ -514,6 +515,12 @@ std::vector<std::string> CheckPlausibility(const PlausibilityInput& input,
   // place, every later figure is meaningless.
   CheckOriginDistance(input, options);
   CheckDatabaseDistance(input, options);
+  if (input.roadmarks != nullptr) {
+    const std::string height = DatabaseHeightProblem(
+        *input.trajectory, input.trajectory_file, *input.roadmarks,
+        *input.frame, DatabaseHeightOptions());
+    if (!height.empty()) throw InputError(input.roadmarks_file, 0, height);
+  }
   CheckHeading(input, options);
   CheckGaps(input, options, &warnings);
   CheckRate(input, options, &warnings);
