@@ -9,6 +9,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -241,6 +242,42 @@ TEST_F(InputMistake, ABrokenGeoPackageSaysWhatGdalAndTheFileSay) {
   EXPECT_THAT(error, HasSubstr("not recognized as"));
   EXPECT_THAT(error, HasSubstr("do not start with the SQLite header"));
   EXPECT_THAT(error, ::testing::Not(HasSubstr("no reason given")));
+}
+
+// Case 6: the whole database 0.8 m east (a datum or epoch mix-up). The run
+// follows the database (the control agrees with itself; the never-worse
+// guard measures against the database), and now warns with the offset and
+// what to check, in report.json and on stderr. A whole run (~10 s).
+TEST_F(InputMistake, ADatabaseOffsetIsWarnedWithTheOffset) {
+  Rewrite(survey_ + "/roadmarks.geojson", [](const std::string& text) {
+    // Every longitude (the first number of each position) + 0.8 m.
+    const double dlon = 0.8 / (111319.49 * std::cos(49.8942 * M_PI / 180.0));
+    std::string out;
+    std::size_t at = 0;
+    for (;;) {
+      const std::size_t open = text.find("[2.", at);
+      if (open == std::string::npos) break;
+      const std::size_t end = text.find(',', open);
+      out += text.substr(at, open + 1 - at);
+      std::ostringstream lon;
+      lon.precision(12);
+      lon << std::stod(text.substr(open + 1, end - open - 1)) + dlon;
+      out += lon.str();
+      at = end;
+    }
+    return out + text.substr(at);
+  });
+  const std::string results = folder_.Path("results");
+  const std::string err = folder_.Path("run.err");
+  ASSERT_EQ(RunZebrageo("--log-level warning run " + Quote(survey_) + " -o " +
+                            Quote(results) + " --threads 2",
+                        folder_.Path("run.out"), err),
+            0)
+      << ReadWholeFile(err);
+  const std::string report = ReadWholeFile(results + "/report.json");
+  EXPECT_THAT(report, HasSubstr("moved the trajectory by one common offset"));
+  EXPECT_THAT(report, HasSubstr("roadmarks_crs"));
+  EXPECT_THAT(ReadWholeFile(err), HasSubstr("one common offset, E +1."));
 }
 
 }  // namespace
