@@ -15,6 +15,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "survey/results.h"
 #include "tests/survey/test_util.h"
@@ -135,6 +136,37 @@ class InputMistake : public ::testing::Test {
   TemporaryFolder folder_;
   std::string survey_;
 };
+
+// Case 1: left and right exchanged in every row of exposures.csv. No band
+// is reconstructed (a survey may have none), and the rectified road says
+// why: a warning on stderr and in report.json. A whole run (~10 s).
+TEST_F(InputMistake, ExchangedCamerasAreNamedWhenNoBandIsReconstructed) {
+  Rewrite(survey_ + "/exposures.csv", [](const std::string& text) {
+    return EachLine(text, [](int number, std::string line) {
+      if (number == 1) return line;
+      for (const auto& [from, to] :
+           {std::pair{",left,", ",right,"}, std::pair{",right,", ",left,"}}) {
+        const auto at = line.find(from);
+        if (at != std::string::npos)
+          return line.replace(at, std::string(from).size(), to);
+      }
+      return line;
+    });
+  });
+  const std::string results = folder_.Path("results");
+  const std::string err = folder_.Path("run.err");
+  ASSERT_EQ(RunZebrageo("--log-level warning run " + Quote(survey_) + " -o " +
+                            Quote(results) + " --threads 2",
+                        folder_.Path("run.out"), err),
+            0)
+      << ReadWholeFile(err);
+  const std::string expected =
+      "exposures.csv: the images of cameras 'left' and 'right' look "
+      "exchanged";
+  EXPECT_THAT(ReadWholeFile(err), HasSubstr(expected));
+  EXPECT_THAT(ReadWholeFile(results + "/report.json"), HasSubstr(expected));
+  EXPECT_THAT(ReadWholeFile(err), HasSubstr("in the camera column of"));
+}
 
 // Case 2: both cameras' rows name the left image.
 TEST_F(InputMistake, BothCamerasNamingOneImageIsAnError) {
