@@ -36,17 +36,9 @@ LineRegistration RegisterLines(
     const AdjustmentData& data, const AdjustmentOptions& options,
     const LineRegistrationOptions& registration, const AdjustmentResult& result,
     const std::vector<ReconstructedLinePoint>& line_points) {
-  LineRegistrationInput input;
-  input.roadmarks = &data.roadmarks;
-  input.frame = &data.frame;
-  input.exposures = &data.exposures;
-  input.vertices = &data.vertices;
-  input.matches = &data.matches;
-  input.trajectory = {&result.corrected_samples, &result.corrected_poses,
-                      result.summary.corrected};
-  input.min_database_sigma_m = options.control.min_database_sigma_m;
-  input.log_warnings = options.log_warnings;
-  return RegisterRoadLines(line_points, input, registration);
+  return RegisterRoadLines(line_points,
+                           LineRegistrationInputOf(data, options, result),
+                           registration);
 }
 
 // The path of a stage output `command` writes; InputError when absent.
@@ -63,6 +55,22 @@ std::string RequiredStageFile(const std::string& results_folder,
 }
 
 }  // namespace
+
+LineRegistrationInput LineRegistrationInputOf(const AdjustmentData& data,
+                                              const AdjustmentOptions& options,
+                                              const AdjustmentResult& result) {
+  LineRegistrationInput input;
+  input.roadmarks = &data.roadmarks;
+  input.frame = &data.frame;
+  input.exposures = &data.exposures;
+  input.vertices = &data.vertices;
+  input.matches = &data.matches;
+  input.trajectory = {&result.corrected_samples, &result.corrected_poses,
+                      result.summary.corrected};
+  input.min_database_sigma_m = options.control.min_database_sigma_m;
+  input.log_warnings = options.log_warnings;
+  return input;
+}
 
 AdjustmentInput AdjustmentData::Input() const {
   AdjustmentInput input;

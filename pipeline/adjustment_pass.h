@@ -62,6 +62,13 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
                                   const std::string& results_folder,
                                   const SurveyPathOptions& paths = {});
 
+// What the road lines' registration reads on `result`'s trajectory: the
+// database, frame, exposures and zebra matches of `data`, the database sigma
+// floor and logging of `options`. Pointers into `data` and `result`.
+LineRegistrationInput LineRegistrationInputOf(const AdjustmentData& data,
+                                              const AdjustmentOptions& options,
+                                              const AdjustmentResult& result);
+
 // What one adjustment gives: its result and, with road lines, their
 // registration.
 struct AdjustmentPass {

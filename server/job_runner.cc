@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -253,9 +254,12 @@ void JobRunner::RunJob(Job job) {
       FinishJob(job.id, pid, exit->exit_code, exit->signal);
       return;
     }
-    const RunProgress progress = ReadRunProgress(files);
+    RunProgress progress = ReadRunProgress(files);
     std::unique_lock<std::mutex> lock(mutex_);
     Running& running = running_[job.id];
+    // The log's tail may lose a stage's progress lines behind later lines
+    // (warnings): what the client saw is never taken back.
+    progress.fraction = std::max(progress.fraction, running.progress.fraction);
     running.progress = progress;
     if (running.term_sent &&
         std::chrono::steady_clock::now() - running.term_time >

@@ -29,16 +29,8 @@ std::vector<LineControlPoint> MatchLinesForAdjustment(
     const std::vector<ReconstructedLinePoint>* points,
     const std::string& folder, std::vector<std::string>* warnings) {
   if (points == nullptr) return {};
-  LineRegistrationInput input;
-  input.roadmarks = &data.roadmarks;
-  input.frame = &data.frame;
-  input.exposures = &data.exposures;
-  input.vertices = &data.vertices;
-  input.matches = &data.matches;
-  input.trajectory = {&zebra.corrected_samples, &zebra.corrected_poses,
-                      zebra.summary.corrected};
-  input.min_database_sigma_m = options.control.min_database_sigma_m;
-  LineRegistration lines = RegisterRoadLines(*points, input, registration);
+  LineRegistration lines = RegisterRoadLines(
+      *points, LineRegistrationInputOf(data, options, zebra), registration);
   warnings->insert(warnings->end(), lines.warnings.begin(),
                    lines.warnings.end());
   if (!folder.empty() && lines.record) {
