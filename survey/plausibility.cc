@@ -12,7 +12,6 @@
 #include <utility>
 
 #include "survey/csv.h"
-#include "survey/database_height.h"
 #include "survey/input_error.h"
 #include "survey/math_util.h"
 #include "survey/option_check.h"
@@ -496,6 +495,7 @@ std::string PlausibilityOptions::Check() const {
   OPTION_GT(check, max_database_distance_m, 0.0);
   OPTION_GE(check, min_speed_mps, 0.0);
   OPTION_GE(check, min_heading_chords, 1);
+  OPTION_NESTED(check, database_height);
   return check.problem();
 }
 
@@ -518,7 +518,7 @@ std::vector<std::string> CheckPlausibility(const PlausibilityInput& input,
   if (input.roadmarks != nullptr) {
     const std::string height = DatabaseHeightProblem(
         *input.trajectory, input.trajectory_file, *input.roadmarks,
-        *input.frame, DatabaseHeightOptions());
+        *input.frame, options.database_height);
     if (!height.empty()) throw InputError(input.roadmarks_file, 0, height);
   }
   CheckHeading(input, options);
