@@ -17,6 +17,7 @@
 #include "survey/crs.h"
 #include "survey/csv.h"
 #include "survey/input_error.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -81,6 +82,17 @@ std::vector<GroundControlPoint> CollectGroundControlPoints(
       (fs::path(results_folder) / kReconstructedBandsFile).string();
   const std::string residuals_path =
       (fs::path(results_folder) / kGcpResidualsFile).string();
+  for (const std::string* path : {&matches_path, &bands_path}) {
+    std::error_code error;
+    if (!fs::is_regular_file(*path, error)) {
+      throw InputError(*path, 0,
+                       "not found: run `zebrageo run SURVEY -o " +
+                           results_folder + "` first");
+    }
+  }
+  const std::string identity = SurveyIdentity(survey.exposures);
+  CheckStageFileSurvey(matches_path, identity);
+  CheckStageFileSurvey(bands_path, identity);
   const std::vector<VertexMatch> matches =
       ReadMatches(matches_path, kMatchesFile);
   std::map<VertexKey, ReconstructedVertex> reconstructed;

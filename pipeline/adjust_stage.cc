@@ -18,6 +18,7 @@
 #include "survey/results.h"
 #include "survey/results_adjustment.h"
 #include "survey/results_lines.h"
+#include "survey/results_survey.h"
 #include "tiepoints/tie_points.h"
 
 namespace zebrageo {
@@ -157,9 +158,10 @@ bool Rematch(const Survey& survey, StageResults* results,
   adjusted.line_control_times = state->pass.line_control_times;
   adjusted.fitted_line_times = state->pass.fitted_line_times;
   adjusted.rejected_crossings = RejectedCrossings(state->pass.result);
-  RematchSummary rematch = RematchStep(
-      survey, options, adjusted, results->Vertices(), state->matches,
-      state->decisions, results->LinePoints(), cancel);
+  RematchSummary rematch =
+      RematchStep(survey, options, adjusted, results->Vertices(),
+                  state->matches, state->decisions,
+                  options.lines ? results->LinePoints() : nullptr, cancel);
   LOG(INFO) << rematch.message;
   // Logged as a warning, so listed in report.json too.
   if (rematch.disagreements > 0) refusals->push_back(rematch.message);
@@ -188,12 +190,15 @@ void WriteAdjustStage(const Survey& survey, const AdjustState& state,
     WriteLineControl(*state.lines->record, path(kLineControlFile));
   }
   if (state.matches_comments) {
-    WriteMatches(state.matches, *state.matches_comments, path(kMatchesFile),
-                 crs.get());
+    WriteMatches(state.matches,
+                 WithSurveyIdentity(survey.exposures, *state.matches_comments),
+                 path(kMatchesFile), crs.get());
   }
   if (state.decisions_comments) {
-    WriteCrossingDecisions(state.decisions, *state.decisions_comments,
-                           path(kCrossingDecisionsFile));
+    WriteCrossingDecisions(
+        state.decisions,
+        WithSurveyIdentity(survey.exposures, *state.decisions_comments),
+        path(kCrossingDecisionsFile));
   }
   // The trajectory and the poses last: their presence means the stage
   // finished.

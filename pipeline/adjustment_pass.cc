@@ -7,6 +7,7 @@
 #include "survey/csv.h"
 #include "survey/input_error.h"
 #include "survey/line_control_points.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -129,11 +130,15 @@ AdjustmentData LoadAdjustmentData(const std::string& survey_folder,
   data.roadmarks = ReadSurveyRoadmarks(survey_folder, data.manifest,
                                        data.trajectory.samples());
   CountMissingImages(&data);
-  data.vertices = ReadReconstructedBands(
-      RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct"),
-      kReconstructedBandsFile);
-  data.matches = ReadMatches(
-      RequiredStageFile(results_folder, kMatchesFile, "match"), kMatchesFile);
+  const std::string identity = SurveyIdentity(data.exposures);
+  const std::string bands_path =
+      RequiredStageFile(results_folder, kReconstructedBandsFile, "reconstruct");
+  CheckStageFileSurvey(bands_path, identity);
+  data.vertices = ReadReconstructedBands(bands_path, kReconstructedBandsFile);
+  const std::string matches_path =
+      RequiredStageFile(results_folder, kMatchesFile, "match");
+  CheckStageFileSurvey(matches_path, identity);
+  data.matches = ReadMatches(matches_path, kMatchesFile);
   return data;
 }
 

@@ -15,6 +15,7 @@
 #include "registration/roadmark_index.h"
 #include "survey/option_json.h"
 #include "survey/output_crs.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -161,8 +162,8 @@ MatchSummary RunMatchStage(const Survey& survey, StageResults* results,
     LOG(WARNING) << warnings.back();
   }
   cancel.ThrowIfCancelled();
-  const std::vector<std::string> comments = {"zebrageo match: " +
-                                             result.summary.BriefReport()};
+  const std::vector<std::string> comments = WithSurveyIdentity(
+      survey.exposures, {"zebrageo match: " + result.summary.BriefReport()});
   WriteMatches(result.matches, comments, results->PathOf(kMatchesFile),
                crs.get());
   WriteCrossingDecisions(result.decisions, comments,

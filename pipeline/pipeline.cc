@@ -14,6 +14,7 @@
 #include "pipeline/run_state.h"
 #include "pipeline/stage_results.h"
 #include "survey/results.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -91,7 +92,7 @@ RunSummary RunSurveyPipeline(const Survey& survey,
   const CancellationToken& cancel = context.cancel;
   // The stage outputs, handed from stage to stage in memory; what a
   // resumed run skips is read from the folder on first use.
-  StageResults stage_results(results_folder);
+  StageResults stage_results(results_folder, SurveyIdentity(survey.exposures));
   StageResults* results = &stage_results;
 
   const std::vector<std::string> fingerprints =

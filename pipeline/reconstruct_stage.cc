@@ -17,6 +17,7 @@
 #include "survey/input_error.h"
 #include "survey/results.h"
 #include "survey/results_lines.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 
@@ -82,7 +83,8 @@ std::vector<std::string> ReconstructBands(
     skipped.push_back({exposure_id, reason});
   }
   WriteSkippedExposures(skipped, results->PathOf(kSkippedExposuresFile));
-  WriteReconstructedBands(vertices, comments,
+  WriteReconstructedBands(vertices,
+                          WithSurveyIdentity(survey.exposures, comments),
                           results->PathOf(kReconstructedBandsFile));
   results->SetReconstruction(std::move(vertices), std::move(skipped));
   LOG(INFO) << "reconstruct: " << summary.BriefReport() << " in "
@@ -113,7 +115,9 @@ std::vector<std::string> ReconstructRoadLines(
   std::vector<std::string> warnings;
   if (summary.lines == 0) warnings.push_back("no road line was reconstructed");
   WriteReconstructedLines(
-      points, {"zebrageo reconstruct --lines: " + summary.BriefReport()},
+      points,
+      WithSurveyIdentity(survey.exposures, {"zebrageo reconstruct --lines: " +
+                                            summary.BriefReport()}),
       results->PathOf(kReconstructedLinesFile));
   results->SetLinePoints(std::move(points));
   LOG(INFO) << "road lines: " << summary.BriefReport();

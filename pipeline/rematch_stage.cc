@@ -7,6 +7,7 @@
 #include "pipeline/adjustment_pass.h"
 #include "registration/paint_probe.h"
 #include "survey/output_crs.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -126,8 +127,8 @@ RematchSummary RunRematchStage(const Survey& survey, StageResults* results,
                   results->Matches(), results->Decisions(),
                   options.lines ? results->LinePoints() : nullptr, cancel);
   if (summary.added == 0 && summary.dropped == 0) return summary;
-  const std::vector<std::string> comments = {"zebrageo run: " +
-                                             summary.message};
+  const std::vector<std::string> comments = WithSurveyIdentity(
+      survey.exposures, {"zebrageo run: " + summary.message});
   WriteMatches(summary.matches, comments, results->PathOf(kMatchesFile),
                crs.get());
   WriteCrossingDecisions(summary.decisions, comments,

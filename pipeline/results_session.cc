@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/stage_results.h"
 #include "survey/results.h"
 
 namespace zebrageo {
@@ -69,6 +70,17 @@ void ResultsSession::Open() {
                      (error ? error.message() : "not a folder"));
   }
   Lock();
+}
+
+void ResultsSession::RefuseAnotherSurvey(const std::string& survey_identity) {
+  std::error_code error;
+  if (!fs::is_directory(folder_, error)) return;
+  try {
+    CheckStageFilesBelongTo(folder_, survey_identity);
+  } catch (...) {
+    on_error_ = OnError::kKeepOutputs;
+    throw;
+  }
 }
 
 void ResultsSession::Lock() {

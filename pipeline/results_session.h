@@ -41,6 +41,11 @@ class ResultsSession {
   // locked). Throws UsageError as the constructor, or when the folder
   // cannot be created.
   void Open();
+  // Throws InputError naming the first stage file of the folder that
+  // belongs to another survey than `survey_identity`'s
+  // (survey/results_survey.h). Such a folder is not this command's to
+  // clean: it is left untouched, whatever `on_error`.
+  void RefuseAnotherSurvey(const std::string& survey_identity);
   // The command finished: its outputs stay.
   void Succeeded() { succeeded_ = true; }
 

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "survey/input_error.h"
+#include "survey/results_survey.h"
 
 namespace zebrageo {
 namespace {
@@ -26,7 +27,14 @@ void MirrorUpperTriangle(Eigen::Matrix3d* c) {
 
 }  // namespace
 
-StageResults::StageResults(std::string folder) : folder_(std::move(folder)) {}
+StageResults::StageResults(std::string folder, std::string survey_identity)
+    : folder_(std::move(folder)),
+      survey_identity_(std::move(survey_identity)) {}
+
+std::string StageResults::SurveyFile(const std::string& path) const {
+  CheckStageFileSurvey(path, survey_identity_);
+  return path;
+}
 
 std::string StageResults::PathOf(const char* name) const {
   return (fs::path(folder_) / name).string();
@@ -52,7 +60,7 @@ std::string RequiredFile(const StageResults& results, const char* name,
 const std::vector<ReconstructedVertex>& StageResults::Vertices() {
   if (!vertices_) {
     vertices_ = ReadReconstructedBands(
-        RequiredFile(*this, kReconstructedBandsFile, "reconstruct"),
+        SurveyFile(RequiredFile(*this, kReconstructedBandsFile, "reconstruct")),
         kReconstructedBandsFile);
   }
   return *vertices_;
@@ -72,7 +80,8 @@ const std::vector<ReconstructedLinePoint>* StageResults::LinePoints() {
     const std::string path = PathOf(kReconstructedLinesFile);
     lines_.emplace();
     if (IsFile(path)) {
-      *lines_ = ReadReconstructedLines(path, kReconstructedLinesFile);
+      *lines_ =
+          ReadReconstructedLines(SurveyFile(path), kReconstructedLinesFile);
     }
   }
   return lines_->has_value() ? &**lines_ : nullptr;
@@ -80,8 +89,8 @@ const std::vector<ReconstructedLinePoint>* StageResults::LinePoints() {
 
 const std::vector<VertexMatch>& StageResults::Matches() {
   if (!matches_) {
-    matches_ =
-        ReadMatches(RequiredFile(*this, kMatchesFile, "match"), kMatchesFile);
+    matches_ = ReadMatches(
+        SurveyFile(RequiredFile(*this, kMatchesFile, "match")), kMatchesFile);
   }
   return *matches_;
 }
@@ -89,9 +98,9 @@ const std::vector<VertexMatch>& StageResults::Matches() {
 const std::vector<CrossingDecision>& StageResults::Decisions() {
   if (!decisions_) {
     const std::string path = PathOf(kCrossingDecisionsFile);
-    decisions_ = IsFile(path)
-                     ? ReadCrossingDecisions(path, kCrossingDecisionsFile)
-                     : std::vector<CrossingDecision>();
+    decisions_ = IsFile(path) ? ReadCrossingDecisions(SurveyFile(path),
+                                                      kCrossingDecisionsFile)
+                              : std::vector<CrossingDecision>();
   }
   return *decisions_;
 }
@@ -118,6 +127,15 @@ const AdjustmentRecord* StageResults::Adjustment() {
     }
   }
   return adjustment_->has_value() ? &**adjustment_ : nullptr;
+}
+
+void CheckStageFilesBelongTo(const std::string& folder,
+                             const std::string& survey_identity) {
+  for (const char* name : {kReconstructedBandsFile, kReconstructedLinesFile,
+                           kMatchesFile, kCrossingDecisionsFile}) {
+    const std::string path = (fs::path(folder) / name).string();
+    if (IsFile(path)) CheckStageFileSurvey(path, survey_identity);
+  }
 }
 
 void StageResults::SetReconstruction(std::vector<ReconstructedVertex> vertices,

@@ -24,7 +24,10 @@ namespace zebrageo {
 
 class StageResults {
  public:
-  explicit StageResults(std::string folder);
+  // `survey_identity` (survey/results_survey.h): the survey the stage
+  // files read from the folder must belong to (InputError naming the file
+  // otherwise); "" reads them unchecked.
+  explicit StageResults(std::string folder, std::string survey_identity = "");
 
   const std::string& folder() const { return folder_; }
   // folder/name.
@@ -57,7 +60,11 @@ class StageResults {
                      AdjustmentRecord record);
 
  private:
+  // `path`, checked to belong to the survey.
+  std::string SurveyFile(const std::string& path) const;
+
   std::string folder_;
+  std::string survey_identity_;
   std::optional<std::vector<ReconstructedVertex>> vertices_;
   std::optional<std::vector<SkippedExposure>> skipped_;
   // Outer optional: looked up; inner: the file exists.
@@ -67,6 +74,12 @@ class StageResults {
   std::optional<std::vector<TrajectorySample>> corrected_;
   std::optional<std::optional<AdjustmentRecord>> adjustment_;
 };
+
+// Throws InputError naming the first stage file of `folder` that belongs
+// to a survey other than `survey_identity`'s (`zebrageo report`, which
+// reads them all).
+void CheckStageFilesBelongTo(const std::string& folder,
+                             const std::string& survey_identity);
 
 }  // namespace zebrageo
 

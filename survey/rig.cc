@@ -378,19 +378,72 @@ void WriteRig(const Rig& rig, const std::string& path) {
   file.Commit();
 }
 
+namespace {
+
+// A stereoCalibrate file is a few kilobytes; FileStorage reads all of it.
+constexpr std::uintmax_t kMaxOpenCvCalibrationBytes = 1 << 20;
+constexpr char kNotOpenCv[] =
+    "not an OpenCV calibration file (a FileStorage YAML, XML or JSON with "
+    "K1, D1, K2, D2, R, T)";
+
+// Refuses what FileStorage should not be handed: a device, a folder, a
+// huge file, binary data (a NUL byte in the first 64 KiB).
+void CheckOpenCvCalibrationFile(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    throw InputError(path, 0,
+                     "cannot open OpenCV calibration file: it does not exist");
+  }
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw InputError(path, 0,
+                     std::string(kNotOpenCv) +
+                         ": a device, pipe or folder, not a regular file");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (!error && size > kMaxOpenCvCalibrationBytes) {
+    throw InputError(path, 0,
+                     std::string(kNotOpenCv) + ": " + std::to_string(size) +
+                         " bytes, more than the " +
+                         std::to_string(kMaxOpenCvCalibrationBytes) +
+                         " of any calibration");
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64 * 1024, '\0');
+  in.read(&head[0], static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  const size_t nul = head.find('\0');
+  if (nul != std::string::npos) {
+    throw InputError(path, 0,
+                     std::string(kNotOpenCv) +
+                         ": binary data (a NUL byte at "
+                         "byte " +
+                         std::to_string(nul) + ")");
+  }
+}
+
+// The first line of an OpenCV error ("... error: (-5:Bad argument) Input
+// file is invalid in function 'open'"), without the source location.
+std::string OpenCvReason(const cv::Exception& e) {
+  std::string reason = e.err.empty() ? e.msg : e.err;
+  const size_t end = reason.find('\n');
+  if (end != std::string::npos) reason.resize(end);
+  return reason;
+}
+
+}  // namespace
+
 Rig ImportOpenCvStereo(const std::string& path, int width, int height,
                        const Eigen::Isometry3d& T_body_left) {
-  std::error_code file_error;
-  if (!std::filesystem::is_regular_file(path, file_error)) {
-    throw InputError(path, 0, "cannot open OpenCV calibration file");
-  }
+  CheckOpenCvCalibrationFile(path);
   cv::FileStorage storage;
   try {
     if (!storage.open(path, cv::FileStorage::READ)) {
       throw InputError(path, 0, "cannot open OpenCV calibration file");
     }
   } catch (const cv::Exception& e) {
-    throw InputError(path, 0, "cannot parse OpenCV calibration file: " + e.msg);
+    throw InputError(path, 0,
+                     std::string(kNotOpenCv) + ": OpenCV cannot parse it (" +
+                         OpenCvReason(e) + ")");
   }
   const int file_width = OptionalInt(storage, "image_width", "width");
   const int file_height = OptionalInt(storage, "image_height", "height");

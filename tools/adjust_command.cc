@@ -11,6 +11,7 @@
 #include "pipeline/results_session.h"
 #include "pipeline/run_options.h"
 #include "survey/math_util.h"
+#include "survey/results_survey.h"
 #include "tools/commands.h"
 #include "tools/progress_bars.h"
 
@@ -49,6 +50,8 @@ void RunAdjust(const AdjustArguments& args) {
   SurveyLoadOptions load_options = LoadOptionsOf(args.stage);
   load_options.require_images = false;
   const Survey survey = LoadSurvey(args.stage.survey, load_options);
+  // Every stage file the command may read, checked once.
+  session.RefuseAnotherSurvey(SurveyIdentity(survey.exposures));
   session.Open();
   StageResults results(args.stage.results);
   const auto start = std::chrono::steady_clock::now();

@@ -40,9 +40,33 @@ CLI::Validator OutputFileValidator() {
       "FILE");
 }
 
-CLI::Validator FiniteWithin(double limit) {
+CLI::Validator OutputFolderValidator() {
   return CLI::Validator(
-      [limit](std::string& text) -> std::string {
+      [](std::string& path) -> std::string {
+        namespace fs = std::filesystem;
+        std::error_code error;
+        // The nearest part of the path that exists must be a folder.
+        for (fs::path p = path; !p.empty(); p = p.parent_path()) {
+          const fs::file_status status = fs::status(p, error);
+          if (!fs::exists(status)) {
+            if (p == p.parent_path()) break;
+            continue;
+          }
+          if (fs::is_directory(status)) return "";
+          return p.string() == path ? path + " is a file, not a folder"
+                                    : p.string() + " is a file: the folder " +
+                                          path + " cannot be created in it";
+        }
+        return "";
+      },
+      "FOLDER");
+}
+
+CLI::Validator FiniteWithin(double limit) { return FiniteIn(-limit, limit); }
+
+CLI::Validator FiniteIn(double low, double high, bool above_low) {
+  return CLI::Validator(
+      [low, high, above_low](std::string& text) -> std::string {
         double value = 0.0;
         if (!CLI::detail::lexical_cast(text, value)) {
           return "'" + text + "' is not a number";
@@ -50,14 +74,23 @@ CLI::Validator FiniteWithin(double limit) {
         if (!std::isfinite(value)) {
           return "'" + text + "' is not a finite number";
         }
-        if (std::abs(value) > limit) {
+        if (value < low || value > high || (above_low && value == low)) {
           std::ostringstream problem;
-          problem << text << " is outside [" << -limit << ", " << limit << "]";
+          problem << text << " is outside " << (above_low ? "(" : "[") << low
+                  << ", " << high << "]";
           return problem.str();
         }
         return "";
       },
       "NUMBER");
+}
+
+void AddMaxFitErrorOption(CLI::App* sub, double* max_fit_error_px) {
+  sub->add_option("--max-fit-error-px", *max_fit_error_px,
+                  "equidistant lenses: largest error of the OpenCV model "
+                  "fitted to the equidistant one (pixels)")
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 100.0, true));
 }
 
 void AddMountOptions(CLI::App* sub, MountArguments* args) {

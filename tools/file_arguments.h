@@ -18,8 +18,18 @@ namespace zebrageo {
 // exists (written atomically there: nothing half-written on failure).
 CLI::Validator OutputFileValidator();
 
+// A folder the command creates (or fills): not a file, and no file where
+// one of its missing parents would be created.
+CLI::Validator OutputFolderValidator();
+
 // A finite number within [-limit, limit] ("nan", "inf" and typos refused).
 CLI::Validator FiniteWithin(double limit);
+// A finite number within [low, high], or (low, high] when `above_low`.
+// CLI::Range lets "nan" through (every comparison with NaN is false).
+CLI::Validator FiniteIn(double low, double high, bool above_low = false);
+
+// --max-fit-error-px of the calibration imports (finite, > 0).
+void AddMaxFitErrorOption(CLI::App* sub, double* max_fit_error_px);
 
 // The mount options of a calibration import (geodata/camera_mount.h).
 struct MountArguments {

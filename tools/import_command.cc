@@ -171,10 +171,7 @@ void AddImportCalibrationCommands(CLI::App* app,
         ->required()
         ->check(CLI::ExistingFile);
     AddRigOutputOptions(sub, args.get());
-    sub->add_option("--max-fit-error-px", args->options.max_fit_error_px,
-                    "largest error of the OpenCV model fitted to an "
-                    "equidistant one (pixels)")
-        ->capture_default_str();
+    AddMaxFitErrorOption(sub, &args->options.max_fit_error_px);
     commands->push_back({sub, [args] {
                            const CameraMount mount = MountOf(args->mount);
                            WriteImportedRig(
@@ -199,10 +196,7 @@ void AddImportCalibrationCommands(CLI::App* app,
         ->required()
         ->check(CLI::ExistingFile);
     AddRigOutputOptions(sub, args.get());
-    sub->add_option("--max-fit-error-px", args->options.max_fit_error_px,
-                    "largest error of the OpenCV model fitted to an "
-                    "equidistant one (pixels)")
-        ->capture_default_str();
+    AddMaxFitErrorOption(sub, &args->options.max_fit_error_px);
     commands->push_back({sub, [args] {
                            const CameraMount mount = MountOf(args->mount);
                            WriteImportedRig(

@@ -211,7 +211,8 @@ void AddInitCommand(CLI::App* app, std::vector<Command>* commands) {
           "--time-clock unix) get GPS - UTC from the leap seconds. ") +
       kMountHelp);
   sub->add_option("survey", args->survey, "survey folder to create")
-      ->required();
+      ->required()
+      ->check(OutputFolderValidator());
   sub->add_option("--images", args->images, "folder of the images")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -239,11 +240,7 @@ void AddInitCommand(CLI::App* app, std::vector<Command>* commands) {
       ->check(CLI::Range(1, 100000));
   sub->add_option("--height", args->height, "opencv: image height (pixels)")
       ->check(CLI::Range(1, 100000));
-  sub->add_option("--max-fit-error-px",
-                  args->calibration_options.max_fit_error_px,
-                  "equidistant lenses: largest error of the fitted OpenCV "
-                  "model (pixels)")
-      ->capture_default_str();
+  AddMaxFitErrorOption(sub, &args->calibration_options.max_fit_error_px);
   AddMountOptions(sub, &args->mount);
   sub->add_option("--roadmarks", args->roadmarks,
                   "road-mark database: a vector file (GeoJSON, GeoPackage, "
@@ -289,7 +286,7 @@ void AddInitCommand(CLI::App* app, std::vector<Command>* commands) {
       ->capture_default_str();
   sub->add_option("--pair-max-dt", args->pair_max_dt_s,
                   "largest time difference (s) of a stereo pair's images")
-      ->check(CLI::Range(0.0, 10.0))
+      ->check(FiniteIn(0.0, 10.0))
       ->capture_default_str();
   sub->add_option("--camera-pattern", args->camera_patterns,
                   "CAMERA=REGEX: the images of a camera, by their path "

@@ -11,6 +11,7 @@
 #include "pipeline/rematch_stage.h"
 #include "pipeline/results_session.h"
 #include "pipeline/run_options.h"
+#include "survey/results_survey.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
 #include "tools/progress_bars.h"
@@ -24,6 +25,8 @@ void RunMatch(const StageArguments& args, const RunOptions& options,
   if (!problem.empty()) throw UsageError("match: " + problem);
   ResultsSession session(args.results, ResultsSession::OnError::kKeepOutputs);
   const Survey survey = LoadSurvey(args.survey, LoadOptionsOf(args));
+  // Every stage file the command may read, checked once.
+  session.RefuseAnotherSurvey(SurveyIdentity(survey.exposures));
   session.Open();
   StageResults results(args.results);
   if (second_pass) {

@@ -12,6 +12,7 @@
 #include "pipeline/run_options.h"
 #include "survey/math_util.h"
 #include "survey/results.h"
+#include "survey/results_survey.h"
 #include "survey/survey.h"
 #include "tools/commands.h"
 #include "tools/progress_bars.h"
@@ -159,22 +160,24 @@ void AddRunCommands(CLI::App* app, std::vector<Command>* commands) {
       app, "report",
       "Write report.json and report.html from an existing results folder.",
       report_args.get());
-  commands->push_back({report, [report_args] {
-                         CheckHasStageOutputs(report_args->results);
-                         ResultsSession session(
-                             report_args->results,
-                             ResultsSession::OnError::kRemoveContractOutputs);
-                         const Survey survey = LoadSurvey(
-                             report_args->survey, LoadOptionsOf(*report_args));
-                         session.Open();
-                         ReportInputs inputs;
-                         inputs.survey = &survey;
-                         inputs.results_folder = report_args->results;
-                         RunReportStage(inputs, ReportOptions());
-                         session.Succeeded();
-                         std::cout << "report: " << report_args->results << "/"
-                                   << kReportHtmlFile << "\n";
-                       }});
+  commands->push_back(
+      {report, [report_args] {
+         CheckHasStageOutputs(report_args->results);
+         ResultsSession session(
+             report_args->results,
+             ResultsSession::OnError::kRemoveContractOutputs);
+         const Survey survey =
+             LoadSurvey(report_args->survey, LoadOptionsOf(*report_args));
+         session.RefuseAnotherSurvey(SurveyIdentity(survey.exposures));
+         session.Open();
+         ReportInputs inputs;
+         inputs.survey = &survey;
+         inputs.results_folder = report_args->results;
+         RunReportStage(inputs, ReportOptions());
+         session.Succeeded();
+         std::cout << "report: " << report_args->results << "/"
+                   << kReportHtmlFile << "\n";
+       }});
 }
 
 }  // namespace zebrageo

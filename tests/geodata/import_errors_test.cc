@@ -108,6 +108,36 @@ TEST_F(ImportErrors, NonFiniteMountNumbersAreUsageErrorsNamingTheOption) {
                 2, {"--pitch-down-deg", "--mount-pitch-deg"});
 }
 
+TEST_F(ImportErrors, NonFiniteImportAndInitNumbersAreUsageErrors) {
+  for (const char* value : {"nan", "inf", "-1", "0"}) {
+    ExpectRefused("import-kalibr " + Quote(camchain_) + " --max-fit-error-px " +
+                      value + Out("rig.yaml"),
+                  2, {"--max-fit-error-px"});
+    ExpectRefused("import-ros-camera-info " + Quote(left_) + " " +
+                      Quote(right_) + " --max-fit-error-px " + value +
+                      Out("rig.yaml"),
+                  2, {"--max-fit-error-px"});
+  }
+  const std::string init =
+      "init " + Quote(tmp_.Path("out/survey")) + " --images " +
+      Quote(tmp_.Path("in")) + " --trajectory " + Quote(random_) +
+      " --calibration " + Quote(camchain_) + " --roadmarks " + Quote(random_);
+  ExpectRefused(init + " --max-fit-error-px nan", 2,
+                {"--max-fit-error-px", "'nan' is not a finite number"});
+  ExpectRefused(init + " --pair-max-dt nan", 2,
+                {"--pair-max-dt", "'nan' is not a finite number"});
+  ExpectRefused(init + " --exif-utc-offset inf", 2,
+                {"--exif-utc-offset", "'inf' is not a finite number"});
+  ExpectRefused(init + " --lever-arm 0 nan 0", 2,
+                {"--lever-arm", "'nan' is not a finite number"});
+  // The survey folder: not a file, nor inside one.
+  const std::string args = init.substr(init.find(" --images"));
+  ExpectRefused("init " + Quote(camchain_) + args, 2,
+                {"survey: ", "camchain.yaml is a file, not a folder"});
+  ExpectRefused("init " + Quote(camchain_ + "/survey") + args, 2,
+                {"camchain.yaml is a file: the folder", "cannot be created"});
+}
+
 TEST_F(ImportErrors, AMissingOrMismatchedCameraNamesTheFileAndKey) {
   const std::string mono =
       tmp_.Write("in/mono.yaml", Camchain("[1280, 960]", false));
@@ -139,7 +169,17 @@ TEST_F(ImportErrors, DevicesAndRandomBytesAreNotTheirFormat) {
     ExpectRefused("import-ros-camera-info " + Quote(input) + " " +
                       Quote(right_) + Out("rig.yaml"),
                   1, {input, "not a ROS camera_info file"});
+    ExpectRefused("import-opencv-stereo " + Quote(input) + Out("rig.yaml"), 1,
+                  {input, "not an OpenCV calibration file"});
   }
+  // Another tool's calibration, and a calibration too large to be one.
+  ExpectRefused("import-opencv-stereo " + Quote(camchain_) + Out("rig.yaml"), 1,
+                {"camchain.yaml: not an OpenCV calibration file",
+                 "OpenCV cannot parse it"});
+  const std::string huge =
+      tmp_.Write("in/huge.yaml", "%YAML:1.0\n" + std::string(2 << 20, ' '));
+  ExpectRefused("import-opencv-stereo " + Quote(huge) + Out("rig.yaml"), 1,
+                {"huge.yaml: not an OpenCV calibration file", "bytes, more"});
   // Text without a NUL byte that is no calibration.
   const std::string text = tmp_.Write("in/notes.txt", "just some notes\n");
   ExpectRefused("import-kalibr " + Quote(text) + Out("rig.yaml"), 1,
