@@ -12,6 +12,7 @@
 #include "geodata/colmap_export.h"
 #include "pipeline/adjust_outputs.h"
 #include "pipeline/adjustment_pass.h"
+#include "pipeline/diagnosis.h"
 #include "pipeline/exit_codes.h"
 #include "pipeline/rematch_stage.h"
 #include "survey/atomic_file.h"
@@ -234,6 +235,33 @@ void WriteAdjustStage(const Survey& survey, const AdjustState& state,
   WriteCameraPoses(result.camera_poses, path(kPosesFile), crs.get());
 }
 
+// The adjustment's correction at each crossing it kept as control or
+// check (its middle observation time), for the diagnosis of a database
+// offset (pipeline/diagnosis.h).
+std::vector<CrossingCorrection> CrossingCorrections(
+    const Survey& survey, const AdjustmentResult& result) {
+  std::vector<CrossingCorrection> crossings;
+  const std::vector<TrajectorySample>& input = survey.trajectory.samples();
+  if (result.corrected_samples.size() != input.size()) return crossings;
+  for (const GuardVerdict& verdict : result.summary.guard_verdicts) {
+    if (!verdict.used) continue;
+    const double time = 0.5 * (verdict.first_time_s + verdict.last_time_s);
+    const auto at = std::lower_bound(
+        input.begin(), input.end(), time,
+        [](const TrajectorySample& s, double t) { return s.time < t; });
+    const size_t i = std::min<size_t>(at - input.begin(), input.size() - 1);
+    CrossingCorrection crossing;
+    crossing.crossing_id = verdict.id;
+    crossing.time_s = time;
+    crossing.correction_enu =
+        survey.frame.EnuFromGeodetic(result.corrected_samples[i].position) -
+        survey.trajectory.poses()[i].p_enu;
+    crossing.stated_sd_enu = input[i].sd_enu_m;
+    crossings.push_back(crossing);
+  }
+  return crossings;
+}
+
 }  // namespace
 
 std::vector<std::string> RunAdjustStage(const Survey& survey,
@@ -267,6 +295,13 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
   results->SetAdjustment(state.pass.result.corrected_samples, state.record);
   std::vector<std::string> warnings = state.warnings;
   warnings.insert(warnings.end(), refusals.begin(), refusals.end());
+  const std::optional<Diagnosis> offset = DiagnoseCommonOffset(
+      CrossingCorrections(survey, state.pass.result), survey.manifest.roadmarks,
+      survey.manifest.trajectory, DiagnosisOptions());
+  if (offset) {
+    LOG(WARNING) << offset->message;
+    warnings.push_back(offset->message);
+  }
   return warnings;
 }
 

@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "pipeline/exit_codes.h"
+#include "pipeline/stereo_order.h"
 #include "reconstruction/reconstruction.h"
 #include "reconstruction/road_lines.h"
 #include "survey/input_error.h"
@@ -88,7 +90,17 @@ std::vector<std::string> ReconstructBands(
   LOG(INFO) << "reconstruct: " << summary.BriefReport() << " in "
             << summary.wall_time_s << " s";
   LOG(INFO) << "reconstruct: " << comments[1];
-  return summary.warnings;
+  std::vector<std::string> warnings = summary.warnings;
+  if (summary.bands == 0) {
+    // Nothing at all: what the images say of the cause.
+    const std::optional<Diagnosis> order =
+        DiagnoseStereoOrder(survey, options, StereoOrderOptions());
+    if (order) {
+      LOG(WARNING) << order->message;
+      warnings.push_back(order->message);
+    }
+  }
+  return warnings;
 }
 
 // The road lines on `road_plane`.

@@ -1,6 +1,7 @@
 #include "survey/exposures.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <utility>
@@ -25,6 +26,12 @@ std::string CameraNames(const Rig& rig) {
     names += (names.empty() ? "" : ", ") + camera.camera.name();
   }
   return names;
+}
+
+// True when two image paths (relative to the survey folder) name one file.
+bool SameImagePath(const std::string& a, const std::string& b) {
+  return std::filesystem::path(a).lexically_normal() ==
+         std::filesystem::path(b).lexically_normal();
 }
 
 ExposureTable BuildTable(const CsvTable& csv, const Rig& rig) {
@@ -75,6 +82,22 @@ ExposureTable BuildTable(const CsvTable& csv, const Rig& rig) {
                         " has two images of camera '" + camera +
                         "' (the other on line " +
                         std::to_string(table.images[slot].line) + ")");
+    }
+    // Two cameras of one instant naming one file see the street from one
+    // place: no disparity anywhere, so no band can be reconstructed.
+    for (int other : exposure.image_of_camera) {
+      if (other >= 0 && SameImagePath(table.images[other].image, image.image)) {
+        csv.Fail(row,
+                 "exposure " + std::to_string(image.exposure_id) +
+                     ": camera '" + camera + "' names image " + image.image +
+                     ", the image camera '" +
+                     rig.cameras.at(table.images[other].camera).camera.name() +
+                     "' names on line " +
+                     std::to_string(table.images[other].line) +
+                     ": the two cameras of a stereo pair would see identical "
+                     "images (zero disparity everywhere, no depth); name each "
+                     "camera's own image");
+      }
     }
     slot = image_index;
     table.images.push_back(std::move(image));

@@ -495,6 +495,7 @@ std::string PlausibilityOptions::Check() const {
   OPTION_GT(check, max_database_distance_m, 0.0);
   OPTION_GE(check, min_speed_mps, 0.0);
   OPTION_GE(check, min_heading_chords, 1);
+  OPTION_NESTED(check, database_height);
   return check.problem();
 }
 
@@ -514,6 +515,12 @@ std::vector<std::string> CheckPlausibility(const PlausibilityInput& input,
   // place, every later figure is meaningless.
   CheckOriginDistance(input, options);
   CheckDatabaseDistance(input, options);
+  if (input.roadmarks != nullptr) {
+    const std::string height = DatabaseHeightProblem(
+        *input.trajectory, input.trajectory_file, *input.roadmarks,
+        *input.frame, options.database_height);
+    if (!height.empty()) throw InputError(input.roadmarks_file, 0, height);
+  }
   CheckHeading(input, options);
   CheckGaps(input, options, &warnings);
   CheckRate(input, options, &warnings);

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "survey/database_height.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
 #include "survey/roadmarks.h"
@@ -53,6 +54,9 @@ struct PlausibilityOptions {
   // The nearest road mark of the database may lie this far (m) from the
   // trajectory at most: farther, nothing in it can control the trajectory.
   double max_database_distance_m = 5e3;
+  // The database's bands against the road under the trajectory (a
+  // vertical datum mix-up: survey/database_height.h).
+  DatabaseHeightOptions database_height;
 
   std::string Check() const;
 };

@@ -11,6 +11,7 @@
 
 #include "survey/atomic_file.h"
 #include "survey/csv.h"
+#include "survey/distortion_check.h"
 #include "survey/image_io.h"
 #include "survey/input_error.h"
 #include "survey/text_file.h"
@@ -194,6 +195,8 @@ class RigParser {
     RigCamera camera;
     camera.camera = Camera(name, width, height, k[0], k[4], k[2], k[5],
                            {d[0], d[1], d[2], d[3], d[4]});
+    const std::string distortion = RadialDistortionProblem(camera.camera);
+    if (!distortion.empty()) Fail(d_node, where + " D: " + distortion);
     // Stored as written (not re-orthonormalised) so a write/read round trip
     // is exact.
     camera.T_body_cam.matrix() = m;
@@ -320,7 +323,12 @@ Camera CameraFromOpenCv(const std::string& name, int width, int height,
   }
   const std::array<double, 5> distortion = {d[0], d[1], d[2], d[3],
                                             d.size() >= 5 ? d[4] : 0.0};
-  return Camera(name, width, height, k[0], k[4], k[2], k[5], distortion);
+  Camera camera(name, width, height, k[0], k[4], k[2], k[5], distortion);
+  const std::string problem = RadialDistortionProblem(camera);
+  if (!problem.empty()) {
+    throw InputError(display_name, 0, "'" + d_key + "': " + problem);
+  }
+  return camera;
 }
 
 }  // namespace

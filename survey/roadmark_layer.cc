@@ -6,9 +6,13 @@
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
+#include <GeographicLib/Geodesic.hpp>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <mutex>
 #include <regex>
 #include <set>
@@ -24,6 +28,10 @@ namespace zebrageo {
 namespace {
 
 constexpr double kMetresPerDegreeLat = 111320.0;
+// A layer whose features all lie farther than this (m) from the survey's
+// area is another place's, or read in the wrong CRS (the contract's
+// GeoJSON: PlausibilityOptions::max_database_distance_m).
+constexpr double kMaxOutsideDistanceM = 5e3;
 // Road lines without their own accuracy (as the GeoJSON reader).
 constexpr double kDefaultLineSigmaXyM = 0.05;
 constexpr double kDefaultLineSigmaZM = 0.10;
@@ -51,6 +59,42 @@ class QuietGdal {
 std::string LastGdalError() {
   const char* message = CPLGetLastErrorMsg();
   return message == nullptr || *message == '\0' ? "no reason given" : message;
+}
+
+// Geodesic distance on the WGS84 ellipsoid (m).
+double GeodesicDistanceM(const Geodetic& a, const Geodetic& b) {
+  double s12 = 0.0;
+  GeographicLib::Geodesic::WGS84().Inverse(a.lat_deg, a.lon_deg, b.lat_deg,
+                                           b.lon_deg, s12);
+  return s12;
+}
+
+// What the file itself shows when GDAL says nothing (a file no driver
+// recognises): empty, or not the SQLite file a GeoPackage is.
+std::string FileEvidence(const std::string& source) {
+  std::error_code error;
+  if (source.rfind("PG:", 0) == 0 ||
+      !std::filesystem::is_regular_file(source, error)) {
+    return "";
+  }
+  const auto size = std::filesystem::file_size(source, error);
+  if (error) return "";
+  if (size == 0) return " (the file is empty: 0 bytes)";
+  const std::string extension =
+      Lower(std::filesystem::path(source).extension().string());
+  if (extension == ".gpkg") {
+    char header[16] = {};
+    std::ifstream(source, std::ios::binary).read(header, sizeof(header));
+    if (std::string(header, sizeof(header)) !=
+        std::string("SQLite format 3\0", 16)) {
+      return " (" + std::to_string(size) +
+             " bytes that do not start with the SQLite header a GeoPackage "
+             "starts with: not a GeoPackage, or a damaged one)";
+    }
+    return " (" + std::to_string(size) +
+           " bytes with a SQLite header: a damaged or truncated GeoPackage?)";
+  }
+  return " (" + std::to_string(size) + " bytes)";
 }
 
 // The index of the field named `wanted`, or guessed from `guesses` when
@@ -204,10 +248,15 @@ class LayerReader {
     layer_->ResetReading();
     RoadmarkDatabase database;
     std::set<std::pair<std::string, int>> seen;
+    std::map<std::string, int> other_types;  // geometry name -> features
     for (auto& feature : *layer_) {
       const OGRGeometry* geometry = feature->GetGeometryRef();
       if (geometry == nullptr) continue;
       const OGRwkbGeometryType type = wkbFlatten(geometry->getGeometryType());
+      if (type != wkbPolygon && type != wkbMultiPolygon &&
+          type != wkbLineString) {
+        ++other_types[OGRGeometryTypeToName(type)];
+      }
       if (type == wkbPolygon || type == wkbMultiPolygon) {
         RoadmarkBand band = ReadBand(*feature, *geometry);
         if (!seen.insert({band.crossing_id, band.band}).second) {
@@ -222,6 +271,10 @@ class LayerReader {
                                           database.lines.size()));
       }
     }
+    if (database.bands.empty() && database.lines.empty()) {
+      FailOnOtherGeometries(other_types);
+      if (options_.area) LookOutsideArea();
+    }
     return database;
   }
 
@@ -231,6 +284,92 @@ class LayerReader {
     throw InputError(where_, 0,
                      "feature " + std::to_string(feature.GetFID()) +
                          " of layer " + layer_->GetName() + ": " + problem);
+  }
+
+  // A layer of points (or other geometries) and no band: the wrong layer
+  // or a conversion that kept the bands' centres.
+  void FailOnOtherGeometries(const std::map<std::string, int>& types) const {
+    if (types.empty()) return;
+    std::string found;
+    for (const auto& [name, count] : types) {
+      found += (found.empty() ? "" : ", ") + std::to_string(count) + " " +
+               name + (count > 1 ? " features" : " feature");
+    }
+    throw InputError(
+        where_, 0,
+        std::string("layer ") + layer_->GetName() + " holds " + found +
+            " and no zebra band: a band is a Polygon (or a MultiPolygon of "
+            "one polygon) whose ring holds its 4 corners, a road line a "
+            "LineString with a type (../shared/SURVEY_FORMAT.md, "
+            "roadmarks.geojson); name the layer of band polygons in "
+            "survey.yaml's roadmarks_layer, or export the bands' outlines "
+            "rather than their centres");
+  }
+
+  // Nothing in the area though the layer holds features: where are they?
+  // A layer far from the survey (its coordinates read in the wrong CRS,
+  // degrees as metres) is an error, as for the contract's GeoJSON
+  // (survey/plausibility.h): nothing in it can control the trajectory.
+  void LookOutsideArea() const {
+    constexpr int kMaxFeatures = 200;
+    layer_->SetSpatialFilter(nullptr);
+    layer_->ResetReading();
+    const GeodeticBox& area = *options_.area;
+    const Geodetic centre{0.5 * (area.south_deg + area.north_deg),
+                          0.5 * (area.west_deg + area.east_deg), 0.0};
+    double min_x = INFINITY, max_x = -INFINITY, min_y = INFINITY,
+           max_y = -INFINITY, nearest_m = INFINITY;
+    Geodetic nearest;
+    int features = 0;
+    for (auto& feature : *layer_) {
+      if (features++ >= kMaxFeatures) break;
+      const OGRGeometry* geometry = feature->GetGeometryRef();
+      if (geometry == nullptr) continue;
+      OGREnvelope box;
+      geometry->getEnvelope(&box);
+      if (!std::isfinite(box.MinX) || !std::isfinite(box.MinY)) continue;
+      min_x = std::min(min_x, box.MinX), max_x = std::max(max_x, box.MaxX);
+      min_y = std::min(min_y, box.MinY), max_y = std::max(max_y, box.MaxY);
+      try {
+        const Geodetic g =
+            transformer_.ToWgs84(Eigen::Vector3d(box.MinX, box.MinY, 0.0));
+        const double d = GeodesicDistanceM(centre, g);
+        if (d < nearest_m) nearest_m = d, nearest = g;
+      } catch (const CrsError&) {
+        // Outside the CRS's domain: far from anything, say the raw figures.
+      }
+    }
+    if (features == 0 || !std::isfinite(min_x)) return;
+    if (nearest_m <= kMaxOutsideDistanceM) return;  // not the survey's area
+    const Crs& crs = transformer_.crs();
+    std::string problem =
+        std::string("none of the features of layer ") + layer_->GetName() +
+        " lies within roadmarks_margin_m of the trajectory: its coordinates "
+        "(x " +
+        FormatDouble(min_x) + " to " + FormatDouble(max_x) + ", y " +
+        FormatDouble(min_y) + " to " + FormatDouble(max_y) + "), read in " +
+        crs.name() +
+        (std::isfinite(nearest_m)
+             ? ", put it at lat " + FormatFixed(nearest.lat_deg, 4) + ", lon " +
+                   FormatFixed(nearest.lon_deg, 4) + ", " +
+                   FormatFixed(nearest_m / 1000.0, 0) +
+                   " km from the trajectory"
+             : ", are outside that CRS's domain") +
+        "; nothing in it can control the trajectory";
+    if (!crs.is_geographic() && min_x >= -180.0 && max_x <= 180.0 &&
+        min_y >= -90.0 && max_y <= 90.0) {
+      problem +=
+          ": they look like longitude and latitude in degrees, read as " +
+          crs.horizontal_unit() + " of a projection; " +
+          (options_.crs.empty()
+               ? std::string("name their CRS (EPSG:4326) in survey.yaml's "
+                             "roadmarks_crs")
+               : std::string("survey.yaml's roadmarks_crs names " +
+                             options_.crs +
+                             ": remove it, or name the CRS the coordinates "
+                             "are in (EPSG:4326)"));
+    }
+    throw InputError(where_, 0, problem);
   }
 
   double Sigma(const OGRFeature& feature, int index, double fallback,
@@ -424,12 +563,14 @@ RoadmarkDatabase ReadRoadmarkLayer(const RoadmarkLayerOptions& options,
       "GPKG", "ESRI Shapefile", "FlatGeobuf",  "GeoJSON", "PostgreSQL", "GML",
       "KML",  "SQLite",         "OpenFileGDB", "CSV",     nullptr};
   GDALDatasetUniquePtr dataset(GDALDataset::Open(
-      options.source.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers,
+      options.source.c_str(),
+      GDAL_OF_VECTOR | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, drivers,
       nullptr, nullptr));
   if (!dataset) {
     throw InputError(where, 0,
-                     "GDAL cannot open it as a vector source: " +
-                         RedactedSource(LastGdalError()));
+                     "GDAL cannot open it as a vector source: GDAL says \"" +
+                         RedactedSource(LastGdalError()) + "\"" +
+                         FileEvidence(options.source));
   }
   OGRLayer* layer = ChooseLayer(dataset.get(), options.layer, where);
   std::string crs_definition = options.crs;

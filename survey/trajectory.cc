@@ -16,6 +16,10 @@
 namespace zebrageo {
 namespace {
 
+// Bounds of a plausible ellipsoidal height of a vehicle (metres).
+constexpr double kMinHeightM = -1000.0;
+constexpr double kMaxHeightM = 10000.0;
+
 const std::vector<std::string>& TrajectoryColumns() {
   static const std::vector<std::string> kColumns = {
       "time", "lat",  "lon",  "h",       "roll",     "pitch",     "heading",
@@ -71,6 +75,17 @@ std::vector<TrajectorySample> SamplesFromTable(
     if (std::abs(s.position.lon_deg) > 180.0) {
       table.Fail(row, "longitude " + FormatDouble(s.position.lon_deg) +
                           " is outside [-180, 180]");
+    }
+    // Ellipsoidal heights on land lie between about -450 m (the Dead Sea
+    // shore) and 8850 m: a height far outside is a broken number (1e308
+    // overflows the adjustment's residuals), not a drift.
+    if (!(s.position.h_m >= kMinHeightM && s.position.h_m <= kMaxHeightM)) {
+      table.Fail(row, "height " + FormatDouble(s.position.h_m) +
+                          " m is not a height on Earth (a vehicle's "
+                          "ellipsoidal height lies between " +
+                          FormatDouble(kMinHeightM) + " and " +
+                          FormatDouble(kMaxHeightM) +
+                          " m): a broken number in the GNSS/INS export");
     }
     if (std::abs(table.GetDouble(row, "pitch")) > 90.0) {
       table.Fail(row, "pitch " + table.GetString(row, "pitch") +
