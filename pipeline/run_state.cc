@@ -12,15 +12,13 @@
 #include "pipeline/progress.h"
 #include "pipeline/version.h"
 #include "survey/atomic_file.h"
+#include "survey/fnv_hash.h"
 
 namespace zebrageo {
 namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-constexpr uint64_t kFnvOffset = 14695981039346656037ull;
-constexpr uint64_t kFnvPrime = 1099511628211ull;
 
 json ReadState(const std::string& path) {
   std::ifstream in(path);
@@ -104,14 +102,12 @@ size_t FirstStageToRun(const std::string& folder,
 
 }  // namespace
 
-StageFingerprint::StageFingerprint() : hash_(kFnvOffset) {
+StageFingerprint::StageFingerprint() : hash_(kFnv1aOffset) {
   Add(ZEBRAGEO_VERSION_STRING).Add(ExecutableStamp());
 }
 
 void StageFingerprint::Mix(const char* data, size_t size) {
-  for (size_t i = 0; i < size; ++i) {
-    hash_ = (hash_ ^ static_cast<unsigned char>(data[i])) * kFnvPrime;
-  }
+  hash_ = Fnv1a(data, size, hash_);
 }
 
 StageFingerprint& StageFingerprint::Add(const std::string& text) {

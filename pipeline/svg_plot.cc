@@ -8,6 +8,8 @@
 #include <sstream>
 #include <utility>
 
+#include "survey/fnv_hash.h"
+
 namespace zebrageo {
 namespace {
 
@@ -69,20 +71,6 @@ struct Range {
     max += pad;
   }
 };
-
-// FNV-1a, 64 bits, as 16 hex digits: stable across compilers (std::hash
-// is not).
-std::string HexHash(const std::string& text) {
-  uint64_t hash = 1469598103934665603ULL;
-  for (unsigned char c : text) {
-    hash ^= c;
-    hash *= 1099511628211ULL;
-  }
-  char buffer[17];
-  std::snprintf(buffer, sizeof(buffer), "%016llx",
-                static_cast<unsigned long long>(hash));
-  return buffer;
-}
 
 }  // namespace
 
@@ -253,8 +241,8 @@ void SvgPlot::WriteData(const Area& area, std::ostream& svg) const {
   WriteMarks(area, data);
   const std::string marks = data.str();
   const std::string id =
-      "clip-" + HexHash(title_ + "|" + std::to_string(area.plot_w) + "|" +
-                        std::to_string(area.plot_h) + "|" + marks);
+      "clip-" + Hex16(Fnv1a(title_ + "|" + std::to_string(area.plot_w) + "|" +
+                            std::to_string(area.plot_h) + "|" + marks));
   svg << "<clipPath id='" << id << "'><rect x='" << kMarginLeft << "' y='"
       << kMarginTop << "' width='" << area.plot_w << "' height='" << area.plot_h
       << "'/></clipPath><g clip-path='url(#" << id << ")'>\n"

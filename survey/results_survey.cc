@@ -8,23 +8,16 @@
 #include <utility>
 
 #include "survey/csv.h"
+#include "survey/fnv_hash.h"
 #include "survey/input_error.h"
 
 namespace zebrageo {
 namespace {
 
-constexpr uint64_t kFnvOffset = 14695981039346656037ull;
-constexpr uint64_t kFnvPrime = 1099511628211ull;
 constexpr char kKey[] = "survey:";
 // The leading comments of a stage file are a few lines; a file whose first
 // 64 KiB are comments names no identity before its header.
 constexpr std::streamsize kMaxCommentBytes = 64 * 1024;
-
-void Mix(const std::string& text, uint64_t* hash) {
-  for (const char c : text) {
-    *hash = (*hash ^ static_cast<unsigned char>(c)) * kFnvPrime;
-  }
-}
 
 std::string Trimmed(const std::string& text) {
   const size_t begin = text.find_first_not_of(" \t\r");
@@ -36,17 +29,13 @@ std::string Trimmed(const std::string& text) {
 }  // namespace
 
 std::string SurveyIdentity(const ExposureTable& exposures) {
-  uint64_t hash = kFnvOffset;
+  uint64_t hash = kFnv1aOffset;
   for (const Exposure& exposure : exposures.exposures) {
-    Mix(std::to_string(exposure.exposure_id) + "@" +
-            FormatDouble(exposure.time) + ";",
-        &hash);
+    hash = Fnv1a(std::to_string(exposure.exposure_id) + "@" +
+                     FormatDouble(exposure.time) + ";",
+                 hash);
   }
-  std::ostringstream hex;
-  hex.width(16);
-  hex.fill('0');
-  hex << std::hex << hash;
-  return hex.str();
+  return Hex16(hash);
 }
 
 std::string SurveyIdentityComment(const std::string& identity) {
