@@ -1,6 +1,6 @@
 // `geometry_sweep [--seeds A-B] [--threads N] [--only KIND] [--max-length M]
 //                 [--no-rematch] [--no-lines] [--no-never-worse]
-//                 [--no-outage-readings] [--no-images]
+//                 [--no-outage-readings] [--no-images] [--junctions N]
 //                 [--verbose SEED -o DIR]`
 //
 // Issue 17's geometry sweep: for each seed, a random simulated survey in
@@ -71,6 +71,11 @@ int Main(int argc, char** argv) {
   app.add_option("--max-length", options.max_road_length_m,
                  "longest road drawn, metres (0: the preset's 1.5 km)")
       ->capture_default_str();
+  app.add_option("--junctions", options.junctions,
+                 "junctions per survey (issue 51): -1 drawn by the random "
+                 "preset, 0 none, N exactly N")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 20));
   app.add_option("--verbose", verbose_seed,
                  "dump this seed's survey and results to -o DIR");
   app.add_option("-o,--output", output, "folder of --verbose");

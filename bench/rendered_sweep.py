@@ -65,6 +65,47 @@ def recall_by_range(survey_path, results):
     return seen, false, len(crossings)
 
 
+def recall_by_street(survey_path, results):
+    """Issue 51's bins: bands of crossings across the road driven ("road")
+    and across a side street ("side", truth/meta.json's "across"). Per bin:
+    bands in full view of >= 2 stereo pairs (exposures) and how many of them
+    were reconstructed in at least one; pairs in view and found; the
+    vertex errors (metres) of found bands within 10 m."""
+    sys.path.insert(0, TOOLS)
+    import numpy as np
+    import score_results as sr
+    s = sr.Survey(survey_path)
+    side = {c["crossing_id"] for c in s.meta.get("crossings", [])
+            if c.get("across") == "side_street"}
+    rec = sr.reconstructed(s, results) if os.path.isfile(
+        os.path.join(results, "reconstructed_bands.csv")) else {}
+    out = {b: {"bands2": 0, "bands2_found": 0, "pairs": 0, "pairs_found": 0, "errs": []}
+           for b in ("road", "side")}
+    found = {}
+    for b in rec.values():
+        key, dc, errs = sr.nearest_band(s, b["enu"])
+        if key is None or dc > 0.3:
+            continue
+        found.setdefault(b["exposure_id"], set()).add(key)
+        if b["range"] <= 10.0:
+            out["side" if key[0] in side else "road"]["errs"] += [float(e) for e in errs]
+    in_view, found_any = {}, set()
+    for e in sorted({r["exposure_id"] for r in s.expo}):
+        for key in s.visible_pairs(e):
+            in_view[key] = in_view.get(key, 0) + 1
+            o = out["side" if key[0] in side else "road"]
+            o["pairs"] += 1
+            if key in found.get(e, set()):
+                o["pairs_found"] += 1
+                found_any.add(key)
+    for key, n in in_view.items():
+        if n >= 2:
+            o = out["side" if key[0] in side else "road"]
+            o["bands2"] += 1
+            o["bands2_found"] += int(key in found_any)
+    return out
+
+
 def score(survey, results, exit_code, seconds):
     row = {"survey": os.path.basename(os.path.normpath(survey)), "exit": int(exit_code),
            "seconds": float(seconds)}
@@ -96,6 +137,10 @@ def score(survey, results, exit_code, seconds):
     row["visible_far"], row["found_far"] = seen["far"]
     row["false_bands"] = false
     row["crossings_in_street"] = crossings
+    try:
+        row["streets"] = recall_by_street(survey, results)
+    except Exception as e:
+        row["error"] = "%s: %s" % (type(e).__name__, e)
     print(json.dumps(row))
 
 
@@ -111,6 +156,28 @@ def spread(values):
 
 def fmt(x, f="%.1f"):
     return "-" if x is None else f % x
+
+
+def streets_summary(rows):
+    """Issue 51: recall and vertex RMSE by crossing across the road driven
+    and across a side street."""
+    for b, name in (("road", "across the road driven"), ("side", "across side streets")):
+        st = [r["streets"][b] for r in rows if "streets" in r]
+        n2 = sum(x["bands2"] for x in st)
+        f2 = sum(x["bands2_found"] for x in st)
+        pv = sum(x["pairs"] for x in st)
+        pf = sum(x["pairs_found"] for x in st)
+        errs = [e for x in st for e in x["errs"]]
+        rmse = math.sqrt(sum(e * e for e in errs) / len(errs)) if errs else float("nan")
+        per = []
+        for x in st:
+            if x["errs"]:
+                per.append(100.0 * math.sqrt(sum(e * e for e in x["errs"]) / len(x["errs"])))
+        print("bands %s: in view in >= 2 pairs %d, reconstructed %s; pairs %s; "
+              "vertex RMSE <= 10 m %.2f cm (%d vertices; per survey median/p95/worst %s cm)" % (
+                  name, n2, "%.1f%% (%d)" % (100.0 * f2 / n2, f2) if n2 else "-",
+                  "%.1f%% (%d/%d)" % (100.0 * pf / pv, pf, pv) if pv else "-",
+                  100.0 * rmse, len(errs), spread(per)))
 
 
 def table(path):
@@ -169,6 +236,7 @@ def table(path):
         "%.1f%% (%d/%d)" % (100.0 * near[1] / near[0], near[1], near[0]) if near[0] else "-",
         "%.1f%% (%d/%d)" % (100.0 * far[1] / far[0], far[1], far[0]) if far[0] else "-",
         sum(r["false_bands"] for r in rows)))
+    streets_summary(rows)
     h_big = sorted(r["h_after"] for r in big)
     fails = []
     if sum(r["wrong"] or 0 for r in rows):

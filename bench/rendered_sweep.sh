@@ -18,6 +18,10 @@
 # (default 2); SEEDS (e.g. "6 10 25") runs those seeds instead of N from
 # FIRST_SEED: the random preset's outage kind (issue 43) is seeds 6 10 25
 # 44 58 101 103 115 116 122 (with MAX_ROAD_LENGTH=700).
+# JUNCTIONS=N (issue 51) gives every survey N junctions (side streets with
+# crossings across them); unset, the random preset draws them (half the
+# surveys). The table bins recall by crossing across the road driven and
+# across a side street.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"
@@ -41,7 +45,8 @@ for seed in $seeds; do
   if [[ ! -f "$survey/survey.yaml" ]]; then
     rm -rf "$survey"
     "$zebrageo" --log-level error simulate --preset random --seed "$seed" \
-      --max-road-length "$max_length" -o "$survey"
+      --max-road-length "$max_length" ${JUNCTIONS:+--set "num_junctions=$JUNCTIONS"} \
+      -o "$survey"
   fi
   rm -rf "$results"
   start=$(date +%s.%N)

@@ -273,6 +273,15 @@ bool ImageScene::Lookup(double x, double y, GroundPoint* g) const {
   CrownAt(g->s, &crown, &grade);
   double cross, slope;
   road_.CrossSectionAndSlope(g->l, &cross, &slope);
+  g->side_street = -1;
+  if (std::abs(g->l) > half_width_ && !world_.side_streets.empty()) {
+    // A side street: level across, at the kerb line's height.
+    g->side_street = SideStreetAt(world_, Eigen::Vector2d(x, y), g->l);
+    if (g->side_street >= 0) {
+      cross = road_.CrossSection(g->l < 0.0 ? -half_width_ : half_width_);
+      slope = 0.0;
+    }
+  }
   g->z = crown + cross;
   g->dzdx = grade * ds_dx + slope * dl_dx;
   g->dzdy = grade * ds_dy + slope * dl_dy;

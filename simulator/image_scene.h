@@ -70,6 +70,7 @@ struct BoxHit {
 struct GroundPoint {
   double s = 0.0, l = 0.0, z = 0.0, dzdx = 0.0, dzdy = 0.0;
   int cell = -1;
+  int side_street = -1;  // index into World::side_streets, -1: none
 };
 
 // The ground's tangent plane where a neighbouring ray hit it: intersecting

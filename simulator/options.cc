@@ -90,6 +90,19 @@ void CheckStreetRanges(const SimulationOptions& o, Checker* c) {
   c->Range("skew_probability", o.skew_probability, 0.0, 1.0);
   c->Range("max_skew_deg", o.max_skew_deg, 0.0, 45.0);
   c->Range("paint_wear", o.paint_wear, 0.0, 1.0);
+  c->Range("num_junctions", o.num_junctions, 0, 1000);
+  c->Range("four_way_probability", o.four_way_probability, 0.0, 1.0);
+  c->Range("junction_max_angle_deg", o.junction_max_angle_deg, 0.0, 45.0);
+  c->Range("min_side_street_width_m", o.min_side_street_width_m, 4.0, 20.0);
+  c->Range("max_side_street_width_m", o.max_side_street_width_m,
+           o.min_side_street_width_m, 20.0);
+  c->Range("side_crossing_probability", o.side_crossing_probability, 0.0, 1.0);
+  c->Range("min_side_crossing_setback_m", o.min_side_crossing_setback_m, 0.0,
+           30.0);
+  c->Range("max_side_crossing_setback_m", o.max_side_crossing_setback_m,
+           o.min_side_crossing_setback_m, 30.0);
+  c->Range("side_crossing_vehicle_probability",
+           o.side_crossing_vehicle_probability, 0.0, 1.0);
   c->Range("missing_paint_probability", o.missing_paint_probability, 0.0, 1.0);
   c->Range("stop_line_probability", o.stop_line_probability, 0.0, 1.0);
   c->Range("lane_line_width_m", o.lane_line_width_m, 0.05, 0.5);
@@ -274,8 +287,8 @@ std::string SimulationOptions::Check() const {
 }
 
 std::vector<std::string> PresetNames() {
-  return {"demo",   "urban",     "outage", "long_outage",
-          "sparse", "ambiguity", "large",  "random"};
+  return {"demo",      "urban", "outage",    "long_outage", "sparse",
+          "ambiguity", "large", "junctions", "random"};
 }
 
 std::string ApplyPreset(const std::string& name, SimulationOptions* options) {
@@ -374,6 +387,20 @@ std::string ApplyPreset(const std::string& name, SimulationOptions* options) {
     o.drift_along_track_m = 0.15;
     o.drift_vertical_m = 0.1;
     o.drift_bias_share = 0.85;
+  } else if (name == "junctions") {
+    // Issue 51: a street of junctions, T and four-way, whose side-street
+    // crossings hold the along-track position; the last control is one.
+    o.road_length_m = 400.0;
+    o.road_width_m = 9.0;
+    o.num_crossings = 3;
+    o.num_stale_crossings = 0;
+    o.min_crossing_spacing_m = 40.0;
+    o.num_junctions = 3;
+    o.four_way_probability = 0.5;
+    o.side_crossing_vehicle_probability = 0.3;
+    o.drift_along_track_m = 0.8;
+    o.drift_cross_track_m = 0.5;
+    o.drift_vertical_m = 0.15;
   } else if (name == "large") {
     o.road_length_m = 10000.0;
     o.num_crossings = 80;

@@ -185,6 +185,27 @@ void DrawFieldOutage(uint64_t seed, const RandomPresetLimits& limits,
   o->outage_start_s = 2.0;  // PlaceOutage moves it
 }
 
+// Junctions (issue 51): half the streets have side streets, one per 150 m
+// or so (1-3), T or four-way, with a crossing on every arm. Drawn from
+// their own generator: the other knobs' draws do not change.
+void DrawJunctions(uint64_t seed, const RandomPresetLimits& limits,
+                   SimulationOptions* o) {
+  std::mt19937_64 rng(sim::SubSeed(seed, kRandomPresetSeed, 3));
+  const bool drawn = Bernoulli(&rng, 0.5);
+  const int count =
+      std::clamp(static_cast<int>(std::lround(o->road_length_m / 150.0 *
+                                              Uniform(&rng, 0.7, 1.3))),
+                 1, 3);
+  const double four_way = Uniform(&rng, 0.2, 0.7);
+  const double vehicle = Uniform(&rng, 0.0, 0.5);
+  o->num_junctions =
+      limits.junctions >= 0 ? limits.junctions : (drawn ? count : 0);
+  // Without junctions the options stay as they were (meta.json included).
+  if (o->num_junctions == 0) return;
+  o->four_way_probability = four_way;
+  o->side_crossing_vehicle_probability = vehicle;
+}
+
 void DrawTrajectoryError(std::mt19937_64* rng, const std::string& kind,
                          const RandomPresetLimits& limits,
                          SimulationOptions* o) {
@@ -303,6 +324,7 @@ std::string DrawRandomOptions(uint64_t seed, const RandomPresetLimits& limits,
   DrawVehicleAndRig(&rng, &o);
   DrawTrajectoryError(&rng, o.scenario, limits, &o);
   DrawDatabase(&rng, o.scenario, &o);
+  DrawJunctions(seed, limits, &o);
   // Extra crossings only in the database go on the road too.
   const double longest_crossing =
       o.max_band_length_m + o.road_width_m * std::tan(30.0 * kPi / 180.0);
@@ -384,6 +406,7 @@ std::string RandomOptionsBrief(const SimulationOptions& o) {
     out << ", repainted x" << o.num_repainted_crossings << " "
         << o.repaint_shift_m << " m";
   }
+  if (o.num_junctions) out << ", junctions x" << o.num_junctions;
   return out.str();
 }
 

@@ -226,7 +226,18 @@ Sample ImageScene::ShadeGround(const Eigen::Vector3d& d, double t,
   const double abs_l = std::abs(g.l);
   float value;
   uint32_t key;
-  if (abs_l <= half_width_ - 0.2) {
+  double side_kerb = 0.0;  // side street: distance to its nearer kerb
+  if (g.side_street >= 0) {
+    const SideStreet& street = world_.side_streets[g.side_street];
+    side_kerb = 0.5 * street.width_m -
+                std::abs((p.head<2>() - street.axis_xy).dot(street.across()));
+  }
+  if (g.side_street >= 0) {
+    value = (side_kerb > 0.2 ? 1.0f : 0.92f) * kAsphaltTone *
+            AsphaltTexture(p.x(), p.y(), footprint,
+                           side_kerb > 0.2 ? salt : salt + 11);
+    key = Key(side_kerb > 0.2 ? kAsphalt : kGutter, 0);
+  } else if (abs_l <= half_width_ - 0.2) {
     value = kAsphaltTone * AsphaltTexture(p.x(), p.y(), footprint, salt);
     key = Key(kAsphalt, 0);
   } else if (abs_l <= half_width_) {

@@ -80,6 +80,16 @@ nlohmann::json RoadJson(const World& world) {
         {{"s_m", {seg.s0, seg.s1}}, {"radius_m", {radius0, radius1}}});
   }
   road["segments"] = segments;
+  nlohmann::json side_streets = nlohmann::json::array();
+  for (const sim::SideStreet& street : world.side_streets) {
+    side_streets.push_back({{"junction", street.junction},
+                            {"s_m", street.s_m},
+                            {"side", street.side > 0 ? "left" : "right"},
+                            {"angle_deg", RadToDeg(street.angle_rad)},
+                            {"width_m", street.width_m},
+                            {"mouth_s_m", {street.mouth_s0, street.mouth_s1}}});
+  }
+  road["side_streets"] = side_streets;
   road["note"] =
       "radius 0 = straight; signed radius > 0 turns left; a segment whose "
       "two radii differ is a clothoid";
@@ -114,6 +124,16 @@ nlohmann::json CrossingJson(const World& world, const sim::Crossing& c) {
   j["occluded_by_vehicle"] = c.occluded_by_vehicle;
   if (!c.db_missing_bands.empty()) j["db_missing_bands"] = c.db_missing_bands;
   if (!c.end_band_vehicle.empty()) j["end_band_vehicle"] = c.end_band_vehicle;
+  // Which street it spans: the road driven, or a side street (issue 51).
+  j["across"] = c.side_street < 0 ? "road" : "side_street";
+  if (c.side_street >= 0) {
+    const sim::SideStreet& street = world.side_streets[c.side_street];
+    j["junction"] = street.junction;
+    j["side"] = street.side > 0 ? "left" : "right";
+    j["junction_angle_deg"] = RadToDeg(street.angle_rad);
+    j["side_street_width_m"] = street.width_m;
+    if (!c.side_vehicle.empty()) j["side_vehicle"] = c.side_vehicle;
+  }
   return j;
 }
 

@@ -107,6 +107,28 @@ struct SimulationOptions {
   // Probability of a stop line before a crossing, across the driving lane.
   double stop_line_probability = 0.4;
 
+  // ------------------------------------------------------------ junctions
+  // Side streets meeting the road (issue 51): T junctions on either side
+  // and four-way junctions (both sides), each arm with a zebra crossing
+  // across the side street, whose bands' long sides lie across the track.
+  // Drawn from their own generator: with 0 junctions the street is the
+  // same as before.
+  int num_junctions = 0;
+  double four_way_probability = 0.4;
+  // Angle between a side street and the road's normal, at most.
+  double junction_max_angle_deg = 30.0;
+  double min_side_street_width_m = 6.0;
+  double max_side_street_width_m = 12.0;
+  // Probability per arm of a crossing across the side street, set back
+  // from the road's kerb line by 1-10 m (the bounds below).
+  double side_crossing_probability = 1.0;
+  double min_side_crossing_setback_m = 1.0;
+  double max_side_crossing_setback_m = 10.0;
+  // Probability per side-street crossing of a vehicle partly hiding it: a
+  // car turning into the side street waiting before it, or one parked at
+  // the side street's kerb over its outer band.
+  double side_crossing_vehicle_probability = 0.3;
+
   // ------------------------------------------------------------ other marks
   // Solid edge lines and a dashed centre line (also in the database).
   bool lane_lines = true;
@@ -345,6 +367,9 @@ struct RandomPresetLimits {
   // Road length range (the geometry sweep's ctest keeps surveys short).
   double min_road_length_m = 60.0;
   double max_road_length_m = 1500.0;
+  // Junctions (issue 51): -1 drawn (half the surveys have 1-3, from their
+  // own generator: the other draws do not change), 0 none, N exactly N.
+  int junctions = -1;
 };
 std::vector<std::string> RandomKinds();
 // Sets `options` (render_images and threads stay at their defaults).

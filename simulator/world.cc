@@ -23,8 +23,11 @@ using world_internal::kMarksSeed;
 using world_internal::kRoadSeed;
 using world_internal::kTextureSeed;
 using world_internal::NearCrossing;
+using world_internal::OpenFacadesAtJunctions;
+using world_internal::ParkAtSideCrossings;
 using world_internal::ParkOverEndBands;
 using world_internal::ParkVehicles;
+using world_internal::PlaceJunctions;
 using world_internal::StopLineBefore;
 using world_internal::Subtract;
 
@@ -233,7 +236,7 @@ void PaintBands(const SimulationOptions& options, World* world) {
       Band band;
       band.crossing = ci;
       band.band = k;
-      band.corners = DesignBandCorners(world->road, c, k, c.origin_xy);
+      band.corners = DesignBandCorners(*world, c, k, c.origin_xy);
       const auto& q = band.corners;
       Eigen::Vector3d normal = (q[2] - q[0]).cross(q[3] - q[1]).normalized();
       if (normal.z() < 0.0) normal = -normal;
@@ -260,12 +263,21 @@ void PaintLines(const SimulationOptions& options, World* world) {
   const double half = 0.5 * road.width_m();
   std::vector<std::pair<double, double>> holes;
   for (const Crossing& c : world->crossings) {
-    if (c.in_street) holes.push_back({c.s_min - 1.0, c.s_max + 1.0});
+    if (c.in_street && c.side_street < 0) {
+      holes.push_back({c.s_min - 1.0, c.s_max + 1.0});
+    }
   }
   if (options.lane_lines) {
     const double end = road.length_m();
     for (double side : {-1.0, 1.0}) {
-      for (const auto& [a, b] : Subtract(0.5, end - 0.5, holes)) {
+      // The edge line stops at the mouths of the side streets.
+      std::vector<std::pair<double, double>> side_holes = holes;
+      for (const SideStreet& street : world->side_streets) {
+        if (street.side == side) {
+          side_holes.push_back({street.mouth_s0 - 0.5, street.mouth_s1 + 0.5});
+        }
+      }
+      for (const auto& [a, b] : Subtract(0.5, end - 0.5, side_holes)) {
         if (b - a < 1.0) continue;
         world->lines.push_back({"lane_solid", side * (half - kEdgeLineInsetM),
                                 options.lane_line_width_m, a, b});
@@ -426,6 +438,11 @@ bool NearCrossing(const World& world, double s0, double s1, double margin) {
     if (!c.in_street) continue;
     if (s1 > c.s_min - margin && s0 < c.s_max + margin) return true;
   }
+  for (const SideStreet& street : world.side_streets) {
+    if (s1 > street.mouth_s0 - margin && s0 < street.mouth_s1 + margin) {
+      return true;
+    }
+  }
   return false;
 }
 
@@ -458,8 +475,9 @@ std::array<Eigen::Vector2d, 4> VerticalBox::Footprint() const {
 }
 
 std::array<Eigen::Vector3d, 4> DesignBandCorners(
-    const Road& road, const Crossing& crossing, int band,
+    const World& world, const Crossing& crossing, int band,
     const Eigen::Vector2d& origin_xy) {
+  const Road& road = world.road;
   const double o0 =
       crossing.first_offset_m + (band - 1) * crossing.band_period_m;
   const double o1 = o0 + crossing.band_width_m;
@@ -474,7 +492,14 @@ std::array<Eigen::Vector3d, 4> DesignBandCorners(
     const double o = ao[(k + start) % 4][1];
     const double along = o * crossing.tan_skew + a;
     const Eigen::Vector2d xy = origin_xy + o * crossing.n + along * crossing.t;
-    const double z = road.SurfaceHeightAt(xy, crossing.s_m + along);
+    double z = 0.0;
+    if (crossing.side_street < 0) {
+      z = road.SurfaceHeightAt(xy, crossing.s_m + along);
+    } else {
+      double s = 0.0, l = 0.0;
+      road.ToRoadCoordinates(xy, crossing.s_m, &s, &l);
+      z = GroundHeight(world, xy, s, l);
+    }
     ring[k] = Eigen::Vector3d(xy.x(), xy.y(), z);
   }
   return ring;
@@ -506,13 +531,16 @@ World BuildWorld(const SimulationOptions& options) {
   world.paint_wear = static_cast<float>(options.paint_wear);
   world.texture_salt = SubSeed(options.seed, kTextureSeed);
   PlaceCrossings(options, &world);
+  PlaceJunctions(options, &world);
   PaintBands(options, &world);
   PaintLines(options, &world);
   PlanDatabaseLineFaults(options, &world);
   PlaceSmallMarks(options, &world);
   BuildFacades(options, &world);
+  OpenFacadesAtJunctions(options, &world);
   ParkVehicles(options, &world);
   ParkOverEndBands(options, &world);
+  ParkAtSideCrossings(options, &world);
   CastShadows(options, &world);
   for (Shadow& shadow : world.shadows) shadow.Finish();
   return world;

@@ -119,6 +119,33 @@ struct Crossing {
   // Road s-range covered by the painted area (with skew), street position.
   double s_min = 0.0, s_max = 0.0;
   uint64_t salt = 0;
+  // Index into World::side_streets of the side street it spans (its `t`
+  // the side street's direction, its origin on that street's axis), or -1
+  // for a crossing of the road driven.
+  int side_street = -1;
+  // "turning" or "parked" when a vehicle partly hides a side-street
+  // crossing, else "".
+  std::string side_vehicle;
+};
+
+// A side street meeting the road at a junction (issue 51). Its surface is
+// level across, at the height of the road's kerb line where it meets it
+// (crown(s) + cross(side * half width) at the road position s beside it).
+// It starts at the road's kerb line and runs length_m from the road's
+// centreline along `direction`.
+struct SideStreet {
+  double s_m = 0.0;        // road position of its axis' foot
+  int side = 1;            // +1: left of the road, -1: right
+  double angle_rad = 0.0;  // from the road's normal, towards +t
+  double width_m = 8.0;
+  double length_m = 60.0;
+  int junction = 0;  // side streets of a four-way junction share it
+  Eigen::Vector2d axis_xy = Eigen::Vector2d::Zero();     // on the centreline
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitY();  // away from it
+  // Road s-range of its mouth at the kerb line.
+  double mouth_s0 = 0.0, mouth_s1 = 0.0;
+
+  Eigen::Vector2d across() const { return {-direction.y(), direction.x()}; }
 };
 
 // A line painted along the road at constant l over [s0, s1].
@@ -182,7 +209,8 @@ struct World {
   double s_drive_end = 0.0;
   double lane_offset_m = 0.0;  // l of the driving lane's centre (right lane)
   std::vector<Crossing> crossings;  // in the street and/or in the database
-  std::vector<Band> bands;          // painted bands, grouped by crossing
+  std::vector<SideStreet> side_streets;
+  std::vector<Band> bands;  // painted bands, grouped by crossing
   std::vector<LinePiece> lines;
   std::vector<StopLine> stop_lines;
   std::vector<DatabaseLineFault> database_line_faults;
@@ -199,12 +227,22 @@ struct World {
 // Builds the street from the options (seeded by options.seed).
 World BuildWorld(const SimulationOptions& options);
 
+// Index of the side street holding horizontal position `xy` (road offset
+// `l` there), -1 if none: beyond the road's kerb on its side, within its
+// width and length.
+int SideStreetAt(const World& world, const Eigen::Vector2d& xy, double l);
+
+// Height of the ground at `xy` (road coordinates s, l): the road's
+// cross-section, or in a side street the kerb line's height beside it.
+double GroundHeight(const World& world, const Eigen::Vector2d& xy, double s,
+                    double l);
+
 // Horizontal corner positions and heights of design band `band` (1-based)
 // of `crossing`, with the crossing's origin at `origin_xy` (the street
 // position, or the database position = street - repaint shift), in ring
 // order (counter-clockwise, rotated by ring_start).
 std::array<Eigen::Vector3d, 4> DesignBandCorners(
-    const Road& road, const Crossing& crossing, int band,
+    const World& world, const Crossing& crossing, int band,
     const Eigen::Vector2d& origin_xy);
 
 // Truth: the bands painted in the street and the lines, exact.

@@ -152,6 +152,14 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
     const double n = Gaussian(&rng, sxy);
     return Eigen::Vector3d(e, n, Gaussian(&rng, sz));
   };
+  // The side streets' crossings draw their noise from their own generator:
+  // the rest of the database does not change with the junctions.
+  std::mt19937_64 side_rng(SubSeed(options.seed, kDatabaseSeed, 8));
+  auto side_noise = [&]() {
+    const double e = Gaussian(&side_rng, sxy);
+    const double n = Gaussian(&side_rng, sxy);
+    return Eigen::Vector3d(e, n, Gaussian(&side_rng, sz));
+  };
   RoadmarkDatabase db;
   for (const Crossing& c : world.crossings) {
     if (!c.in_db) continue;
@@ -161,7 +169,7 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
           c.db_missing_bands.end()) {
         continue;  // the gap keeps the street's numbering
       }
-      const auto corners = DesignBandCorners(world.road, c, k, origin);
+      const auto corners = DesignBandCorners(world, c, k, origin);
       RoadmarkBand out;
       out.crossing_id = c.id;
       out.band = k;
@@ -169,7 +177,8 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
       out.sigma_z_m = sz;
       for (int v = 0; v < 4; ++v) {
         out.corners[v] =
-            frame.GeodeticFromEnu(corners[v] + c.db_offset_enu + noise());
+            frame.GeodeticFromEnu(corners[v] + c.db_offset_enu +
+                                  (c.side_street < 0 ? noise() : side_noise()));
       }
       db.bands.push_back(out);
     }

@@ -22,6 +22,7 @@ enum Purpose : uint64_t {
   kDatabaseSeed = 4,
   kBuildingSeed = 5,
   kVehicleSeed = 6,
+  kJunctionSeed = 7,
   kTextureSeed = 9,
 };
 
@@ -35,6 +36,14 @@ StopLine StopLineBefore(const World& world, int ci,
 
 // True when [s0, s1] comes within `margin` of a crossing in the street.
 bool NearCrossing(const World& world, double s0, double s1, double margin);
+
+// Side streets and the crossings across them (world_junctions.cc), after
+// the road's crossings, from their own generator.
+void PlaceJunctions(const SimulationOptions& options, World* world);
+// Buildings cut back from the side streets' mouths (world_junctions.cc).
+void OpenFacadesAtJunctions(const SimulationOptions& options, World* world);
+// Vehicles partly hiding side-street crossings (world_junctions.cc).
+void ParkAtSideCrossings(const SimulationOptions& options, World* world);
 
 // The scenery (world_scenery.cc), in this order after the road marks.
 void BuildFacades(const SimulationOptions& options, World* world);

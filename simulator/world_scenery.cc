@@ -146,6 +146,7 @@ void ParkVehicles(const SimulationOptions& options, World* world) {
   // Vehicles hiding the outer bands of a crossing from the approach.
   for (int ci = 0; ci < static_cast<int>(world->crossings.size()); ++ci) {
     Crossing& c = world->crossings[ci];
+    if (c.side_street >= 0) continue;  // ParkAtSideCrossings
     const bool want = Bernoulli(&rng, options.occluding_vehicle_probability);
     const double length = Uniform(&rng, 4.0, 4.8);
     const double gap = Uniform(&rng, 0.6, 1.5);
@@ -184,6 +185,7 @@ void ParkOverEndBands(const SimulationOptions& options, World* world) {
   const Road& road = world->road;
   const double half_width = 0.5 * road.width_m();
   for (Crossing& c : world->crossings) {
+    if (c.side_street >= 0) continue;  // ParkAtSideCrossings
     const bool want = Bernoulli(&rng, options.end_band_vehicle_probability);
     const bool first = Bernoulli(&rng, 0.5);
     const double length = Uniform(&rng, 4.0, 4.8);
@@ -224,8 +226,8 @@ void CastShadows(const SimulationOptions& options, World* world) {
   for (const ParkedVehicle& v : world->vehicles) {
     double s = 0.0, l = 0.0;
     road.ToRoadCoordinates(v.box.centre, 0.5 * (v.s0 + v.s1), &s, &l);
-    world->shadows.push_back(
-        CastShadow(v.box, road.Height(s, l), world->sun_enu, 0.5f));
+    world->shadows.push_back(CastShadow(
+        v.box, GroundHeight(*world, v.box.centre, s, l), world->sun_enu, 0.5f));
     // Contact shadow under the body.
     VerticalBox under = v.box;
     under.half_u += 0.15;

@@ -353,6 +353,7 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
   SimulationOptions simulation;
   simulation.seed = seed;
   RandomPresetLimits limits;
+  limits.junctions = options.junctions;
   if (options.max_road_length_m > 0.0) {
     limits.max_road_length_m =
         std::min(limits.max_road_length_m, options.max_road_length_m);

@@ -38,6 +38,9 @@ struct GeometrySweepOptions {
   // Road lengths drawn by the random preset are limited to this (metres):
   // the ctest keeps surveys small. 0: the preset's own range.
   double max_road_length_m = 0.0;
+  // Junctions of the random preset (RandomPresetLimits::junctions): -1
+  // drawn, 0 none, N exactly N per survey.
+  int junctions = -1;
   // Only surveys of this random kind (simulator.h: RandomKinds()); empty:
   // all.
   std::string only_kind;
