@@ -272,6 +272,15 @@ ViewResult ModelBandInImage(const BandContext& context, int i,
   return ViewResult::kOk;
 }
 
+// Mean height standard deviation of the monoplotted points of `side`
+// (0 when it was triangulated).
+double MonoplotHeightSigma(const LongSideDetection& detection,
+                           const LongSide& side) {
+  double sum = 0.0;
+  for (int k : side.support) sum += detection.points[k].monoplot_height_sigma_m;
+  return side.support.empty() ? 0.0 : sum / side.support.size();
+}
+
 // Covariance of each vertex: along the band from the transversal line
 // fits, across from the long side regression, and the band plane's height
 // error, which moves a vertex along its viewing ray.
@@ -307,8 +316,11 @@ void VertexCovariances(const BandContext& context, int i,
             : std::max(options.min_sigma_m,
                        s.lateral_rms_m /
                            std::sqrt(static_cast<double>(s.support.size())));
+    // A monoplotted long side (monoplot.h) has the height of the local
+    // surface it was cut with: its error moves the side along the ray.
     const double sigma_height =
-        std::max(options.min_sigma_m, std::sqrt(plane_fit.HeightVariance(p)));
+        std::max({options.min_sigma_m, std::sqrt(plane_fit.HeightVariance(p)),
+                  MonoplotHeightSigma(context.detection, s)});
     const Eigen::Vector3d along_ray = ray / std::abs(plane_normal.dot(ray));
     band->covariances_body[v] =
         sigma_along * sigma_along * x_axis * x_axis.transpose() +

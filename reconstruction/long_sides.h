@@ -138,6 +138,10 @@ struct EdgePoint3d {
   Eigen::Vector2d xy_left = Eigen::Vector2d::Zero();   // rectified pixel
   Eigen::Vector2d gradient = Eigen::Vector2d::Zero();  // rectified, left
   int index_in_chain = 0;  // position along the left image chain
+  // > 0: the point was not triangulated but monoplotted (monoplot.h): its
+  // left image ray cut by the local road surface, whose height has this
+  // standard deviation (metres); it moves the point along that ray.
+  double monoplot_height_sigma_m = 0.0;
 };
 // Points in order along a left image edge chain.
 struct EdgeChain3d {

@@ -91,6 +91,7 @@ std::string ReconstructionOptions::Check() const {
   OPTION_NESTED(check, matching);
   OPTION_NESTED(check, search);
   OPTION_NESTED(check, road_plane);
+  OPTION_NESTED(check, monoplot);
   OPTION_NESTED(check, zebra);
   OPTION_NESTED(check, long_sides);
   OPTION_NESTED(check, bands);
@@ -101,7 +102,7 @@ std::string ReconstructionOptions::Check() const {
 
 double StepTimings::Total() const {
   return read_images_s + rectify_s + edges_s + matching_s + road_plane_s +
-         long_sides_s + bands_s + debug_images_s;
+         monoplot_s + long_sides_s + bands_s + debug_images_s;
 }
 
 void StepTimings::Add(const StepTimings& other) {
@@ -110,6 +111,7 @@ void StepTimings::Add(const StepTimings& other) {
   edges_s += other.edges_s;
   matching_s += other.matching_s;
   road_plane_s += other.road_plane_s;
+  monoplot_s += other.monoplot_s;
   long_sides_s += other.long_sides_s;
   bands_s += other.bands_s;
   debug_images_s += other.debug_images_s;
@@ -121,8 +123,9 @@ std::string StepTimings::Report() const {
   out.precision(1);
   out << "read " << 1e3 * read_images_s << " ms, rectify " << 1e3 * rectify_s
       << " ms, edges " << 1e3 * edges_s << " ms, matching " << 1e3 * matching_s
-      << " ms, road plane " << 1e3 * road_plane_s << " ms, long sides "
-      << 1e3 * long_sides_s << " ms, bands " << 1e3 * bands_s << " ms";
+      << " ms, road plane " << 1e3 * road_plane_s << " ms, monoplot "
+      << 1e3 * monoplot_s << " ms, long sides " << 1e3 * long_sides_s
+      << " ms, bands " << 1e3 * bands_s << " ms";
   if (debug_images_s > 0.0) {
     out << ", debug images " << 1e3 * debug_images_s << " ms";
   }
@@ -191,12 +194,22 @@ PairReconstruction StereoPairReconstructor::Reconstruct(
   result.road_plane = fit.ok ? fit.plane : prior;
   result.road_points = static_cast<int>(fit.inliers.size());
   std::vector<Eigen::Vector2d> road_xy, off_road_xy;
-  const std::vector<EdgeChain3d> chains =
+  std::vector<EdgeChain3d> chains =
       ChainsNearRoad(fit, centre, options_, &by_chain,
                      debug_prefix.empty() ? nullptr : &road_xy,
                      debug_prefix.empty() ? nullptr : &off_road_xy);
   result.timings.road_plane_s = ThreadCpuSeconds() - start;
   if (stop_after_road_plane || !fit.ok) return result;
+
+  // The edges along the epipolar lines, monoplotted (issue 51).
+  start = ThreadCpuSeconds();
+  std::vector<EdgeChain3d> monoplotted =
+      MonoplotRowEdges(rect, edges[0], by_chain, fit.plane,
+                       options_.road_plane.keep_distance_m, options_.monoplot);
+  result.monoplotted_chains = static_cast<int>(monoplotted.size());
+  for (EdgeChain3d& chain : monoplotted) chains.push_back(std::move(chain));
+  result.timings.monoplot_s = ThreadCpuSeconds() - start;
+  VLOG(2) << "monoplot: " << result.monoplotted_chains << " chains";
 
   start = ThreadCpuSeconds();
   const PlaneFrame frame =
@@ -204,6 +217,8 @@ PairReconstruction StereoPairReconstructor::Reconstruct(
   const LongSideDetection detection =
       DetectLongSides(chains, frame, options_.zebra, options_.long_sides);
   result.long_sides = static_cast<int>(detection.sides.size());
+  VLOG(2) << "long sides: " << result.long_sides << " in "
+          << detection.directions.size() << " directions";
   result.timings.long_sides_s = ThreadCpuSeconds() - start;
 
   start = ThreadCpuSeconds();

@@ -11,6 +11,8 @@
 //      slab around the road plane), sub-pixel disparity, triangulation to
 //      3D edge chains (edge_matching.h);
 //   4. road plane by RANSAC + least squares, edges near it (road_plane.h);
+//      the edges along the epipolar lines, which no disparity measures,
+//      monoplotted on the local road surface (monoplot.h, issue 51);
 //   5. long sides: polygonisation, accumulator, grouping (long_sides.h);
 //   6. bands: side pairs, band planes, Hough transversal sides, vertices and
 //      covariances (band_modeling.h).
@@ -38,6 +40,7 @@
 #include "reconstruction/band_modeling.h"
 #include "reconstruction/edge_matching.h"
 #include "reconstruction/long_sides.h"
+#include "reconstruction/monoplot.h"
 #include "reconstruction/road_plane.h"
 #include "reconstruction/road_rectification.h"
 #include "reconstruction/search_volume.h"
@@ -55,6 +58,7 @@ struct ReconstructionOptions {
   MatchingOptions matching;
   SearchVolumeOptions search;
   RoadPlaneOptions road_plane;
+  MonoplotOptions monoplot;
   ZebraSpecification zebra;
   LongSideOptions long_sides;
   BandOptions bands;
@@ -78,6 +82,7 @@ struct ReconstructionOptions {
     v("matching", matching);
     v("search", search);
     v("road_plane", road_plane);
+    v("monoplot", monoplot);
     v("zebra", zebra);
     v("long_sides", long_sides);
     v("bands", bands);
@@ -96,6 +101,7 @@ struct StepTimings {
   double edges_s = 0.0;
   double matching_s = 0.0;
   double road_plane_s = 0.0;
+  double monoplot_s = 0.0;  // issue 51: edges along the epipolar lines
   double long_sides_s = 0.0;
   double bands_s = 0.0;
   double debug_images_s = 0.0;
@@ -113,6 +119,7 @@ struct PairReconstruction {
   int edge_points[2] = {0, 0};
   int matches = 0;
   int road_points = 0;
+  int monoplotted_chains = 0;
   int long_sides = 0;
   StepTimings timings;
 };
