@@ -61,7 +61,9 @@ int Shell(const std::string& command, std::string* output = nullptr) {
 }
 
 // ---------------------------------------------------------------------------
-// The jobs `plan` writes, on a short survey cut into blocks of 150 m.
+// The jobs `plan` writes, on a short survey cut into blocks of 150 m (tiny
+// images: plan reads their headers only; ctest runs each case in a process
+// of its own, each simulating it).
 
 class CampaignJobs : public ::testing::Test {
  protected:
@@ -71,8 +73,8 @@ class CampaignJobs : public ::testing::Test {
     Zebrageo(
         "simulate --preset demo --seed 4 --set road_length_m=420 --set "
         "num_crossings=7 --set num_stale_crossings=0 --set "
-        "min_crossing_spacing_m=40 --set image_width=640 --set "
-        "image_height=480 --set focal_px=560 --set supersampling=1 "
+        "min_crossing_spacing_m=40 --set image_width=320 --set "
+        "image_height=240 --set focal_px=280 --set supersampling=1 "
         "--set exposure_spacing_m=6 -o " +
             Quote(survey),
         *folder_);
