@@ -27,6 +27,113 @@ void MedianSpread(std::vector<double> values, double* median, double* spread) {
   *spread = 1.4826 * Median(values);
 }
 
+// The run's height over the road plane along the rows (rectified x).
+struct HeightLine {
+  double a = 0.0, b = 0.0, sigma = 0.0;
+  bool ok = false;
+};
+
+// A line through heights h at rows' abscissae x, without the outliers
+// (mismatches: beyond 3 robust spreads, at least 1 cm); a constant when
+// they span less than min_span_px.
+HeightLine FitHeightLine(const std::vector<double>& x,
+                         const std::vector<double>& h, double min_span_px,
+                         const MonoplotOptions& options) {
+  HeightLine line;
+  if (static_cast<int>(h.size()) < options.min_height_points) return line;
+  double median = 0.0, spread = 0.0;
+  MedianSpread(h, &median, &spread);
+  const double limit = std::max(0.01, 3.0 * spread);
+  double sx = 0, sh = 0, sxx = 0, sxh = 0;
+  int n = 0;
+  for (size_t k = 0; k < h.size(); ++k) {
+    if (std::abs(h[k] - median) > limit) continue;
+    sx += x[k];
+    sh += h[k];
+    sxx += x[k] * x[k];
+    sxh += x[k] * h[k];
+    ++n;
+  }
+  if (n < options.min_height_points) return line;
+  const double mx = sx / n, mh = sh / n;
+  const double vxx = sxx / n - mx * mx;
+  line.b =
+      vxx > 0.25 * min_span_px * min_span_px ? (sxh / n - mx * mh) / vxx : 0.0;
+  line.a = mh - line.b * mx;
+  double r2 = 0.0;
+  for (size_t k = 0; k < h.size(); ++k) {
+    if (std::abs(h[k] - median) > limit) continue;
+    const double r = h[k] - line.a - line.b * x[k];
+    r2 += r * r;
+  }
+  const double rms = std::sqrt(r2 / n);
+  if (rms > options.max_height_spread_m) return line;
+  // The line's error at the run, and the surface's own departure from it.
+  line.sigma = std::max(options.min_height_sigma_m, 2.0 * rms / std::sqrt(n));
+  line.ok = true;
+  return line;
+}
+
+// The triangulated points near the road whose edges cross the rows (a
+// match along them is a guess), by 16-pixel cell of the left image; the
+// height line of those around a run's two ends (its band's ends).
+class EndHeights {
+ public:
+  EndHeights(
+      const std::vector<std::vector<std::pair<int, EdgePoint3d>>>& by_chain,
+      const RoadPlane& plane, double keep_distance_m,
+      const MonoplotOptions& options, double ground_pixel_m)
+      : options_(options),
+        radius_px_(options.end_radius_m / ground_pixel_m),
+        min_span_px_(options.min_height_span_m / ground_pixel_m) {
+    for (const auto& chain : by_chain) {
+      for (const auto& [index, p] : chain) {
+        const double g = p.gradient.norm();
+        if (!(std::abs(p.gradient.y()) <
+              std::cos(options.max_row_angle_rad) * g)) {
+          continue;
+        }
+        const double d = plane.SignedDistance(p.p_body);
+        if (std::abs(d) > keep_distance_m) continue;
+        cells_[Key(Cell(p.xy_left.x()), Cell(p.xy_left.y()))].push_back(
+            {p.xy_left.x(), p.xy_left.y(), d});
+      }
+    }
+  }
+
+  HeightLine Around(const EdgePoint& first, const EdgePoint& last) const {
+    std::vector<double> x, h;
+    const int64_t r = static_cast<int64_t>(std::ceil(radius_px_ / kCell));
+    for (const EdgePoint* e : {&first, &last}) {
+      for (int64_t i = Cell(e->x) - r; i <= Cell(e->x) + r; ++i) {
+        for (int64_t j = Cell(e->y) - r; j <= Cell(e->y) + r; ++j) {
+          const auto it = cells_.find(Key(i, j));
+          if (it == cells_.end()) continue;
+          for (const Known& k : it->second) {
+            if (std::hypot(k.x - e->x, k.y - e->y) > radius_px_) continue;
+            x.push_back(k.x);
+            h.push_back(k.h);
+          }
+        }
+      }
+    }
+    return FitHeightLine(x, h, min_span_px_, options_);
+  }
+
+ private:
+  struct Known {
+    double x, y, h;
+  };
+  static constexpr double kCell = 16.0;
+  static int64_t Cell(double v) {
+    return static_cast<int64_t>(std::floor(v / kCell));
+  }
+  static int64_t Key(int64_t i, int64_t j) { return i * 1000003 + j; }
+  const MonoplotOptions& options_;
+  double radius_px_, min_span_px_;
+  std::unordered_map<int64_t, std::vector<Known>> cells_;
+};
+
 }  // namespace
 
 std::string MonoplotOptions::Check() const {
@@ -52,93 +159,8 @@ std::vector<EdgeChain3d> MonoplotRowEdges(
   const Eigen::Vector3d centre = rectification.left_centre_body();
   const int min_points = static_cast<int>(
       std::ceil(options.min_run_length_m / rectification.ground_pixel_m()));
-  // The run's height over `plane` along the rows (rectified x): a line
-  // through the chain's own triangulated points (the band's ends, matched
-  // in stereo), a constant when they span less than min_height_span_px.
-  struct HeightLine {
-    double a = 0.0, b = 0.0, sigma = 0.0;
-    bool ok = false;
-  };
-  // The triangulated points near the road whose edges cross the rows (a
-  // match along them is a guess), by 16-pixel cell of the left image.
-  struct Known {
-    double x, y, h;
-  };
-  constexpr double kCell = 16.0;
-  std::unordered_map<int64_t, std::vector<Known>> cells;
-  auto key = [](int64_t i, int64_t j) { return i * 1000003 + j; };
-  for (const auto& chain : by_chain) {
-    for (const auto& [index, p] : chain) {
-      const double g = p.gradient.norm();
-      if (!(std::abs(p.gradient.y()) <
-            std::cos(options.max_row_angle_rad) * g)) {
-        continue;
-      }
-      const double d = plane.SignedDistance(p.p_body);
-      if (std::abs(d) > keep_distance_m) continue;
-      cells[key(static_cast<int64_t>(std::floor(p.xy_left.x() / kCell)),
-                static_cast<int64_t>(std::floor(p.xy_left.y() / kCell)))]
-          .push_back({p.xy_left.x(), p.xy_left.y(), d});
-    }
-  }
-  const double radius_px =
-      options.end_radius_m / rectification.ground_pixel_m();
-  // The heights of the points around both ends of a run (its band's ends).
-  auto run_height = [&](const std::vector<int>& run) {
-    HeightLine line;
-    std::vector<double> x, h;
-    for (int end : {run.front(), run.back()}) {
-      const EdgePoint& e = left.points[end];
-      const int64_t r = static_cast<int64_t>(std::ceil(radius_px / kCell));
-      const int64_t ci = static_cast<int64_t>(std::floor(e.x / kCell));
-      const int64_t cj = static_cast<int64_t>(std::floor(e.y / kCell));
-      for (int64_t i = ci - r; i <= ci + r; ++i) {
-        for (int64_t j = cj - r; j <= cj + r; ++j) {
-          const auto it = cells.find(key(i, j));
-          if (it == cells.end()) continue;
-          for (const Known& k : it->second) {
-            if (std::hypot(k.x - e.x, k.y - e.y) > radius_px) continue;
-            x.push_back(k.x);
-            h.push_back(k.h);
-          }
-        }
-      }
-    }
-    if (static_cast<int>(h.size()) < options.min_height_points) return line;
-    double median = 0.0, spread = 0.0;
-    MedianSpread(h, &median, &spread);
-    // Without the outliers (mismatches): within 3 spreads (>= 1 cm).
-    const double limit = std::max(0.01, 3.0 * spread);
-    double sx = 0, sh = 0, sxx = 0, sxh = 0;
-    int n = 0;
-    for (size_t k = 0; k < h.size(); ++k) {
-      if (std::abs(h[k] - median) > limit) continue;
-      sx += x[k];
-      sh += h[k];
-      sxx += x[k] * x[k];
-      sxh += x[k] * h[k];
-      ++n;
-    }
-    if (n < options.min_height_points) return line;
-    const double mx = sx / n, mh = sh / n;
-    const double vxx = sxx / n - mx * mx;
-    const double span_px =
-        options.min_height_span_m / rectification.ground_pixel_m();
-    line.b = vxx > 0.25 * span_px * span_px ? (sxh / n - mx * mh) / vxx : 0.0;
-    line.a = mh - line.b * mx;
-    double r2 = 0.0;
-    for (size_t k = 0; k < h.size(); ++k) {
-      if (std::abs(h[k] - median) > limit) continue;
-      const double r = h[k] - line.a - line.b * x[k];
-      r2 += r * r;
-    }
-    const double rms = std::sqrt(r2 / n);
-    if (rms > options.max_height_spread_m) return line;
-    // The line's error at the run, and the surface's own departure from it.
-    line.sigma = std::max(options.min_height_sigma_m, 2.0 * rms / std::sqrt(n));
-    line.ok = true;
-    return line;
-  };
+  const EndHeights heights(by_chain, plane, keep_distance_m, options,
+                           rectification.ground_pixel_m());
   auto monoplot_run = [&](const std::vector<int>& run, const HeightLine& h) {
     if (static_cast<int>(run.size()) < min_points || !h.ok) return;
     EdgeChain3d chain;
@@ -171,7 +193,8 @@ std::vector<EdgeChain3d> MonoplotRowEdges(
     std::vector<int> run, pending;
     auto flush = [&]() {
       if (static_cast<int>(run.size()) >= min_points) {
-        monoplot_run(run, run_height(run));
+        monoplot_run(run, heights.Around(left.points[run.front()],
+                                         left.points[run.back()]));
       }
       run.clear();
       pending.clear();
