@@ -6,20 +6,18 @@
 # source file names at the default log level (they are there with
 # --log-level debug); one closing line with the results folder and the
 # headline figure. Exit 77 (skipped) without `script`.
-# Usage: console_output_test.sh ZEBRAGEO_BINARY
+# The survey is the small_demo_run fixture's (tests/tools/small_demo_run.sh);
+# the runs write their own results folder.
+# Usage: console_output_test.sh ZEBRAGEO_BINARY FIXTURE_DIR
 set -euo pipefail
 zebrageo="$1"
+survey="$2/survey"
 command -v script >/dev/null || { echo "SKIP: no script (util-linux)"; exit 77; }
 work="$(mktemp -d "${TMPDIR:-/tmp}/zebrageo-console-test.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
-"$zebrageo" --log-level error simulate --preset demo --seed 1 \
-  --set road_length_m=80 --set num_crossings=2 --set num_stale_crossings=0 \
-  --set min_crossing_spacing_m=25 --set image_width=640 --set image_height=480 \
-  --set focal_px=560 --set supersampling=2 --set exposure_spacing_m=4 \
-  -o "$work/survey" >/dev/null
-script -q -e -c "'$zebrageo' run '$work/survey' -o '$work/results'" \
+script -q -e -c "'$zebrageo' run '$survey' -o '$work/results'" \
   "$work/tty" >/dev/null
-"$zebrageo" --log-level debug run "$work/survey" -o "$work/results" \
+"$zebrageo" --log-level debug run "$survey" -o "$work/results" \
   --from adjust >"$work/debug.out" 2>"$work/debug.err"
 python3 - "$work" <<'PY'
 import re, sys
