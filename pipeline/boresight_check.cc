@@ -33,6 +33,9 @@ std::string BoresightCheckOptions::Check() const {
   }
   if (!(min_sigmas > 0.0)) return "min_sigmas: must be > 0";
   if (!(max_applied_sd_rad > 0.0)) return "max_applied_sd_rad: must be > 0";
+  if (!(max_observed_sd_rad >= max_applied_sd_rad)) {
+    return "max_observed_sd_rad: must be >= max_applied_sd_rad";
+  }
   std::string problem = observations.Check();
   if (!problem.empty()) return "observations." + problem;
   problem = estimate.Check();
@@ -64,10 +67,15 @@ BoresightCheck CheckBoresight(const Survey& survey,
             << " (scatter: direction " << RadToDeg(e.direction_sigma_rad)
             << ", turn " << RadToDeg(e.turn_sigma_rad) << ", road "
             << RadToDeg(e.plane_sigma_rad) << " deg)";
-  if (!check.checked) return check;
+  if (!check.checked) {
+    LOG(INFO) << "boresight check: too few camera motions and road planes "
+                 "in the images to check the rig's mount";
+    return check;
+  }
   bool unappliable = false;
   for (int k = 0; k < 3; ++k) {
     const double angle = std::abs(e.rotation_body_rad[k]);
+    if (e.sd_rad[k] > options.max_observed_sd_rad) continue;
     if (angle > options.min_significant_rad &&
         angle > options.min_sigmas * e.sd_rad[k]) {
       check.significant = true;
@@ -102,19 +110,21 @@ BoresightCheck CheckBoresight(const Survey& survey,
 }
 
 nlohmann::json BoresightCheckJson(const BoresightCheck& check) {
-  nlohmann::json json = {{"checked", check.checked}};
-  if (!check.checked) return json;
   const MountMisalignment& e = check.estimate;
+  // Not checked: the images gave too few camera motions and road planes
+  // (the counts say how few).
+  nlohmann::json json = {{"checked", check.checked},
+                         {"camera_motions", e.steps_used},
+                         {"road_planes", e.planes_used},
+                         {"significant", check.significant},
+                         {"applied", !check.applied_rad.isZero()}};
+  if (!check.checked) return json;
   for (int k = 0; k < 3; ++k) {
     const std::string axis = kAxisNames[k];
     json[axis + "_deg"] = RadToDeg(e.rotation_body_rad[k]);
     json[axis + "_sd_deg"] = RadToDeg(e.sd_rad[k]);
     json[axis + "_applied_deg"] = RadToDeg(check.applied_rad[k]);
   }
-  json["camera_motions"] = e.steps_used;
-  json["road_planes"] = e.planes_used;
-  json["significant"] = check.significant;
-  json["applied"] = !check.applied_rad.isZero();
   return json;
 }
 

@@ -38,6 +38,9 @@ struct BoresightCheckOptions {
   double min_significant_rad = DegToRad(0.2);
   // ... and beyond this many of its standard deviations.
   double min_sigmas = 4.0;
+  // An axis with a larger sd is not observed: it is neither evidence of a
+  // misalignment nor applied.
+  double max_observed_sd_rad = DegToRad(0.5);
   // An axis is applied only with a standard deviation below this: a
   // turn left of 0.15 degrees moves a band 10 m away by 2.6 cm, which the
   // registration's tolerances and the adjustment take.
@@ -56,6 +59,7 @@ struct BoresightCheckOptions {
     v("apply", apply);
     v("min_significant_rad", min_significant_rad);
     v("min_sigmas", min_sigmas);
+    v("max_observed_sd_rad", max_observed_sd_rad);
     v("max_applied_sd_rad", max_applied_sd_rad);
     v("self_calibrate_after", self_calibrate_after);
   }

@@ -54,6 +54,9 @@ struct MountMisalignmentOptions {
   // the field cases show with their stated rigs (yaw -0.17 +- 0.11 and
   // 0.15 +- 0.17 degrees).
   double direction_bias_sd_rad = 0.0015;
+  // The rotation's prior sd on each axis (radians): what an import can
+  // lose is a few degrees.
+  double prior_sd_rad = 0.035;
   // Fewer motions or planes: that evidence is not used.
   int min_steps = 4;
   int min_planes = 4;
