@@ -18,6 +18,7 @@ PACKAGES=(
   python3 python3-numpy python3-opencv python3-yaml
   chromium
   libcpp-httplib-dev libsqlite3-dev libarchive-dev python3-prometheus-client
+  slurm-wlm munge
 )
 
 # The npm tools of the server's tests (tests/server/js: an OpenAPI validator,

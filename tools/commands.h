@@ -80,6 +80,8 @@ void AddInitCommand(CLI::App* app, std::vector<Command>* commands);
 void PrintSurveySummary(const Survey& survey);
 // export-gcp (tools/export_command.cc).
 void AddExportGcpCommand(CLI::App* app, std::vector<Command>* commands);
+// plan, run-block, merge (tools/campaign_commands.cc).
+void AddCampaignCommands(CLI::App* app, std::vector<Command>* commands);
 // serve (tools/serve_command.cc).
 void AddServeCommand(CLI::App* app, std::vector<Command>* commands);
 

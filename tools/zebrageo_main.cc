@@ -102,6 +102,7 @@ int Main(int argc, char** argv) {
   AddInitCommand(&app, &commands);
   AddExportGcpCommand(&app, &commands);
   AddServeCommand(&app, &commands);
+  AddCampaignCommands(&app, &commands);
 
   const std::string unknown = UnknownCommand(app, argc, argv);
   if (!unknown.empty()) {

@@ -24,7 +24,9 @@ ALLOWED = {
     "simulator": {"survey"},
     "pipeline": {"survey", "geodata"} | STAGES,
     "server": {"pipeline", "survey"},
-    "tools": {"pipeline", "survey", "geodata", "simulator", "server"},
+    "campaign": {"pipeline", "survey"},
+    "tools": {"pipeline", "survey", "geodata", "simulator", "server",
+              "campaign"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([a-z_]+)/[^"]+"')
 
