@@ -171,7 +171,7 @@ MatchSummary RunMatchStage(const Survey& survey, StageResults* results,
   WriteMatchEvidence(result, EvidenceOptions(options.matching), warnings,
                      survey.frame, results->PathOf(kMatchEvidenceFile));
   WriteMatchesGeoJson(MatchedVertexFeatures(input, result), result.faults,
-                      survey.frame, results->PathOf(kMatchesGeoJsonFile));
+                      survey.frame, results->folder(), crs.get());
   LOG(INFO) << "match: " << result.summary.BriefReport();
   results->SetMatches(std::move(result.matches), std::move(result.decisions));
   return result.summary;

@@ -8,7 +8,9 @@
 //                           or no_candidate, and why
 //   match_evidence.json     the evidence behind each decision, the database
 //                           faults found, the options and the summary
-//   matches.geojson         the matches and faults for QGIS
+//   matches.geojson         the vertex matches as lines, for QGIS
+//   matched_bands.geojson   the matched bands corrected, as polygons
+//   database_faults.geojson the database faults found, as points
 // (survey/results.h, survey/results_match.h).
 #ifndef ZEBRAGEO_PIPELINE_MATCH_STAGE_H_
 #define ZEBRAGEO_PIPELINE_MATCH_STAGE_H_

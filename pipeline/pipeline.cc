@@ -3,11 +3,13 @@
 #include <glog/logging.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "pipeline/adjust_stage.h"
+#include "pipeline/boresight_check.h"
 #include "pipeline/exit_codes.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/reconstruct_stage.h"
@@ -29,7 +31,8 @@ double PeakMemoryMb() {
 // (threads).
 nlohmann::json ReconstructOptionsJson(const RunOptions& options) {
   nlohmann::json json = RunOptionsToJson(options);
-  nlohmann::json read = {{"lines", json["lines"]},
+  nlohmann::json read = {{"boresight", json["boresight"]},
+                         {"lines", json["lines"]},
                          {"reconstruction", json["reconstruction"]},
                          {"road_lines", json["road_lines"]}};
   read["reconstruction"].erase("threads");
@@ -78,18 +81,44 @@ std::vector<std::string> StageFingerprints(const Survey& survey,
 
 }  // namespace
 
-RunSummary RunSurveyPipeline(const Survey& survey,
+RunSummary RunSurveyPipeline(const Survey& input_survey,
                              const std::string& results_folder,
-                             const RunOptions& options,
+                             const RunOptions& requested_options,
                              const RunContext& context) {
   // This thread's lines, and those of the workers the stages start, go to
   // the run's own log too.
   const ScopedRunLog log_scope(context.log);
-  const std::string problem = options.Check();
+  const std::string problem = requested_options.Check();
   if (!problem.empty()) throw UsageError(problem);
-  LOG(INFO) << "run: " << survey.folder << " -> " << results_folder;
+  LOG(INFO) << "run: " << input_survey.folder << " -> " << results_folder;
   const ProgressListener& progress = context.progress;
   const CancellationToken& cancel = context.cancel;
+  // The rig's mount against the images', before anything depends on it:
+  // every stage works with the mount the check leaves. It is deterministic
+  // in rig.yaml, the trajectory and the images, which the stages'
+  // fingerprints hold, so a resumed run finds the same (and repeats the
+  // check: a few seconds).
+  const BoresightCheck boresight = CheckBoresight(
+      input_survey, requested_options.boresight, progress, cancel);
+  RunOptions options = requested_options;
+  Survey corrected;
+  const bool turned = !boresight.applied_rad.isZero();
+  if (turned) {
+    corrected = input_survey;
+    corrected.rig = RotateRigMount(input_survey.rig, boresight.applied_rad);
+    // What the estimate leaves (its sd) the adjustment calibrates, the
+    // estimate its prior: amiens-short with the mount angles lost,
+    // attitude 0.180 -> 0.074 deg, H 7.2 -> 6.4 cm (0 wrong matches
+    // either way).
+    RigCalibrationOptions& calibration = options.adjustment.rig_calibration;
+    if (requested_options.boresight.self_calibrate_after &&
+        !calibration.self_calibrate_rig) {
+      calibration.self_calibrate_rig = true;
+      calibration.boresight_sigma_rad =
+          std::max(boresight.estimate.sd_rad.maxCoeff(), 1e-4);
+    }
+  }
+  const Survey& survey = turned ? corrected : input_survey;
   // The stage outputs, handed from stage to stage in memory; what a
   // resumed run skips is read from the folder on first use.
   StageResults stage_results(results_folder, SurveyIdentity(survey.exposures));
@@ -132,10 +161,16 @@ RunSummary RunSurveyPipeline(const Survey& survey,
   inputs.results_folder = results_folder;
   inputs.timings = run.timings;
   inputs.warnings = run.warnings;
+  if (!boresight.message.empty()) {
+    inputs.warnings.insert(inputs.warnings.begin(), boresight.message);
+  }
+  if (options.boresight.enabled) {
+    inputs.boresight = BoresightCheckJson(boresight);
+  }
   inputs.peak_memory_mb = PeakMemoryMb();
   RunSummary summary;
   summary.timings = run.timings;
-  summary.warnings = run.warnings;
+  summary.warnings = inputs.warnings;
   summary.report = RunReportStage(inputs, options.report);
   return summary;
 }

@@ -382,6 +382,7 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
   }
   if (inputs.peak_memory_mb > 0.0)
     report["peak_memory_mb"] = inputs.peak_memory_mb;
+  if (!inputs.boresight.is_null()) report["boresight"] = inputs.boresight;
 
   report["warnings"] =
       WithoutRepeats(ReportWarnings(inputs, options, data, matched, &report));

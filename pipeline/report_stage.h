@@ -47,6 +47,8 @@ struct ReportInputs {
   std::vector<StageTiming> timings;
   double peak_memory_mb = 0.0;
   std::vector<std::string> warnings;  // from the stages
+  // The boresight check's verdict (pipeline/boresight_check.h), or null.
+  nlohmann::json boresight;
 };
 
 // Builds the report JSON (SURVEY_FORMAT.md: counts, RMS before and after,

@@ -11,6 +11,7 @@ namespace zebrageo {
 std::string RunOptions::Check() const {
   OptionCheck check;
   OPTION_GE(check, threads, 0);
+  OPTION_NESTED(check, boresight);
   OPTION_NESTED(check, reconstruction);
   OPTION_NESTED(check, road_lines);
   OPTION_NESTED(check, matching);

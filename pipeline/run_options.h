@@ -13,6 +13,7 @@
 #include <string>
 
 #include "adjustment/adjustment_options.h"
+#include "pipeline/boresight_check.h"
 #include "pipeline/report_stage.h"
 #include "reconstruction/reconstruction.h"
 #include "reconstruction/road_lines.h"
@@ -37,6 +38,8 @@ struct RunOptions {
   // depends on them.
   int threads = 0;
 
+  // Before reconstruct: the rig's mount against what the images observe.
+  BoresightCheckOptions boresight;
   // reconstruct: zebra bands, then road lines.
   ReconstructionOptions reconstruction;
   RoadLineOptions road_lines;
@@ -61,6 +64,7 @@ struct RunOptions {
     v("lines", lines);
     v("rematch", rematch);
     v("threads", threads);
+    v("boresight", boresight);
     v("reconstruction", reconstruction);
     v("road_lines", road_lines);
     v("matching", matching);

@@ -1,6 +1,7 @@
 #include "survey/results_match.h"
 
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -8,6 +9,7 @@
 
 #include "survey/atomic_file.h"
 #include "survey/math_util.h"
+#include "survey/output_crs.h"
 
 namespace zebrageo {
 namespace {
@@ -148,14 +150,20 @@ void WriteMatchEvidence(const MatchResult& result,
 
 void WriteMatchesGeoJson(const std::vector<MatchedVertexFeature>& vertices,
                          const std::vector<DatabaseFault>& faults,
-                         const LocalFrame& frame, const std::string& path) {
-  json features = json::array();
+                         const LocalFrame& frame, const std::string& folder,
+                         const OutputCrs* crs) {
+  const auto position = [&](const Eigen::Vector3d& p_enu) {
+    if (crs == nullptr) return Position(frame, p_enu);
+    const Eigen::Vector3d xyz = crs->FromWgs84(frame.GeodeticFromEnu(p_enu));
+    return json::array({xyz.x(), xyz.y(), Round(xyz.z(), 1e-4)});
+  };
+  json lines = json::array(), bands = json::array(), points = json::array();
   for (const MatchedVertexFeature& f : vertices) {
     const VertexMatch& m = f.match;
-    features.push_back(FeatureOf(
+    lines.push_back(FeatureOf(
         {{"type", "LineString"},
-         {"coordinates", json::array({Position(frame, f.measured_enu),
-                                      Position(frame, f.database_enu)})}},
+         {"coordinates",
+          json::array({position(f.measured_enu), position(f.database_enu)})}},
         {{"kind", "vertex_match"},
          {"exposure_id", m.exposure_id},
          {"band_id", m.band_id},
@@ -170,9 +178,9 @@ void WriteMatchesGeoJson(const std::vector<MatchedVertexFeature>& vertices,
     if (f.corrected_band_enu) {
       json ring = json::array();
       for (int v = 0; v <= 4; ++v) {
-        ring.push_back(Position(frame, (*f.corrected_band_enu)[v % 4]));
+        ring.push_back(position((*f.corrected_band_enu)[v % 4]));
       }
-      features.push_back(
+      bands.push_back(
           FeatureOf({{"type", "Polygon"}, {"coordinates", json::array({ring})}},
                     {{"kind", "matched_band_corrected"},
                      {"exposure_id", m.exposure_id},
@@ -182,27 +190,36 @@ void WriteMatchesGeoJson(const std::vector<MatchedVertexFeature>& vertices,
     }
   }
   for (const DatabaseFault& f : faults) {
-    features.push_back(
-        FeatureOf({{"type", "Point"},
-                   {"coordinates",
-                    Position(frame, Eigen::Vector3d(f.location_enu.x(),
-                                                    f.location_enu.y(), 0.0))}},
-                  {{"kind", "database_fault"},
-                   {"fault", FaultKindName(f.kind)},
-                   {"crossing_id", f.crossing_id.empty() ? json(nullptr)
-                                                         : json(f.crossing_id)},
-                   {"band", f.band == 0 ? json(nullptr) : json(f.band)},
-                   {"views", f.views},
-                   {"description", f.description}}));
+    points.push_back(FeatureOf(
+        {{"type", "Point"},
+         {"coordinates", position(Eigen::Vector3d(f.location_enu.x(),
+                                                  f.location_enu.y(), 0.0))}},
+        {{"kind", "database_fault"},
+         {"fault", FaultKindName(f.kind)},
+         {"crossing_id",
+          f.crossing_id.empty() ? json(nullptr) : json(f.crossing_id)},
+         {"band", f.band == 0 ? json(nullptr) : json(f.band)},
+         {"views", f.views},
+         {"description", f.description}}));
   }
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    // One feature per line: diffable, and QGIS reads it as it is.
-    out << "{\"type\": \"FeatureCollection\", \"features\": [\n";
-    for (size_t i = 0; i < features.size(); ++i) {
-      out << (i > 0 ? ",\n" : "") << features[i].dump();
-    }
-    out << "\n]}\n";
-  });
+  const std::string crs_member =
+      crs == nullptr ? "" : "\"crs\": " + crs->GeoJsonMember().dump() + ", ";
+  const auto write = [&](const json& features, const char* name) {
+    WriteFileAtomically((std::filesystem::path(folder) / name).string(),
+                        [&](std::ostream& out) {
+                          // One feature per line: diffable, and QGIS reads it
+                          // as it is.
+                          out << "{\"type\": \"FeatureCollection\", "
+                              << crs_member << "\"features\": [\n";
+                          for (size_t i = 0; i < features.size(); ++i) {
+                            out << (i > 0 ? ",\n" : "") << features[i].dump();
+                          }
+                          out << "\n]}\n";
+                        });
+  };
+  write(lines, kMatchesGeoJsonFile);
+  write(bands, kMatchedBandsGeoJsonFile);
+  write(points, kDatabaseFaultsGeoJsonFile);
 }
 
 }  // namespace zebrageo

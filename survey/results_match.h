@@ -4,10 +4,16 @@
 //   match_evidence.json  the evidence behind each decision, the database
 //                        faults found, the options and the summary
 //   matches.geojson      for QGIS: each matched vertex as a line from its
-//                        measured placement to its database corner, the
-//                        matched bands placed with the estimated
-//                        correction, and the database faults as points
-// each written atomically.
+//                        measured placement to its database corner
+//   matched_bands.geojson  the matched bands placed with the estimated
+//                        correction, as polygons
+//   database_faults.geojson  the database faults found, as points
+// each written atomically. One geometry type per file (a GIS layer holds
+// one: OGR's GeoJSON driver reads a mixed file as one "Unknown" layer that
+// a shapefile or GeoPackage cannot take). With survey.yaml's output_crs,
+// the three GeoJSON files are in that CRS with a top-level "crs" member,
+// as bands.geojson (survey/output_crs.h): RFC 7946 allows WGS84 only, so
+// they then leave the RFC for GeoJSON 2008, which GDAL and QGIS read.
 #ifndef ZEBRAGEO_SURVEY_RESULTS_MATCH_H_
 #define ZEBRAGEO_SURVEY_RESULTS_MATCH_H_
 
@@ -26,6 +32,10 @@ namespace zebrageo {
 
 inline constexpr char kMatchEvidenceFile[] = "match_evidence.json";
 inline constexpr char kMatchesGeoJsonFile[] = "matches.geojson";
+inline constexpr char kMatchedBandsGeoJsonFile[] = "matched_bands.geojson";
+inline constexpr char kDatabaseFaultsGeoJsonFile[] = "database_faults.geojson";
+
+class OutputCrs;
 
 // A horizontal correction of the measured pose at one exposure
 // (registration/band_matcher.h): p_true = Rz(heading_rad) (p - p_vehicle)
@@ -132,10 +142,13 @@ struct MatchedVertexFeature {
   Eigen::Vector3d database_enu = Eigen::Vector3d::Zero();
   std::optional<std::array<Eigen::Vector3d, 4>> corrected_band_enu;
 };
-// matches.geojson: the vertices in order, then the faults as points.
+// matches.geojson (the vertices in order, as lines), matched_bands.geojson
+// and database_faults.geojson into `folder`; in `crs` when not null, else
+// WGS84 (RFC 7946). Throws InputError when PROJ cannot convert a position.
 void WriteMatchesGeoJson(const std::vector<MatchedVertexFeature>& vertices,
                          const std::vector<DatabaseFault>& faults,
-                         const LocalFrame& frame, const std::string& path);
+                         const LocalFrame& frame, const std::string& folder,
+                         const OutputCrs* crs = nullptr);
 
 }  // namespace zebrageo
 

@@ -54,8 +54,8 @@ void AddMatchCommand(CLI::App* app, std::vector<Command>* commands) {
   CLI::App* sub = AddStageSubcommand(
       app, "match",
       "Match reconstructed bands to the road-mark database; writes "
-      "matches.csv, crossing_decisions.csv, match_evidence.json and "
-      "matches.geojson.",
+      "matches.csv, crossing_decisions.csv, match_evidence.json, "
+      "matches.geojson, matched_bands.geojson and database_faults.geojson.",
       args.get());
   sub->add_option("--max-drift-m", matching->max_drift_m,
                   "horizontal trajectory error the search allows (m)")

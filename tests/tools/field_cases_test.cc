@@ -10,9 +10,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
 
@@ -79,6 +81,14 @@ TEST_P(FieldCase, MeetsTheIssueTargets) {
   const CaseRun& run = RunOf(GetParam());
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_TRUE(ScoreRun("match", GetParam(), "--max-wrong 0").passed);
+  // Their rigs state the mount: no boresight diagnosis (issue 47).
+  std::ifstream report_file(run.results + "/report.json");
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  EXPECT_FALSE(report.at("boresight").value("significant", true))
+      << report["boresight"].dump();
+  EXPECT_EQ(run.err.find("diagnosis: the images observe the cameras' mount"),
+            std::string::npos)
+      << run.err;
   EXPECT_TRUE(ScoreRun("poses", GetParam(),
                        "--max-h 0.05 --max-v 0.08 --att-not-worse-deg 0.01")
                   .passed);

@@ -6,7 +6,10 @@
 
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <utility>
 
+#include "survey/results_match.h"
 #include "tests/tools/geodata_util.h"
 
 namespace zebrageo {
@@ -136,6 +139,64 @@ TEST_F(OutputCrs, PosesAgreeWithCs2csOnTheWgs84OutputToAMillimetre) {
   const double x =
       bands["features"][0]["geometry"]["coordinates"][0][0][0].get<double>();
   EXPECT_GT(x, 100000.0);  // a Lambert-93 easting, not a longitude
+}
+
+// matches.geojson and its two companions (issue 47): one geometry type
+// each, in the output CRS with its "crs" member, as GDAL reads them; in
+// WGS84 without output_crs.
+TEST_F(OutputCrs, MatchesGeoJsonHoldOneGeometryTypeEachInTheOutputCrs) {
+  if (!HaveProgram("ogrinfo") || !fs::exists(kEgm96Grid)) {
+    GTEST_SKIP() << "ogrinfo or " << kEgm96Grid
+                 << " missing (Debian gdal-bin, proj-data)";
+  }
+  const std::string results = ProcessCopy(
+      "geojson", std::string("output_crs: \"") + kOutputCrs + "\"\n");
+  ASSERT_FALSE(results.empty());
+  const std::pair<const char*, const char*> files[] = {
+      {kMatchesGeoJsonFile, "Line String"},
+      {kMatchedBandsGeoJsonFile, "Polygon"},
+      {kDatabaseFaultsGeoJsonFile, "Point"}};
+  int features_seen = 0;
+  for (const auto& [file, geometry] : files) {
+    SCOPED_TRACE(file);
+    const nlohmann::json json =
+        nlohmann::json::parse(ReadWholeFile(results + "/" + file));
+    EXPECT_EQ(json["crs"]["properties"]["name"],
+              "urn:ogc:def:crs,crs:EPSG::2154,crs:EPSG::5773");
+    const std::string log = folder_->Path(std::string(file) + ".ogrinfo");
+    ASSERT_EQ(Shell("ogrinfo -ro -so -al " + Quote(results + "/" + file), log),
+              0)
+        << ReadWholeFile(log);
+    const std::string info = ReadWholeFile(log);
+    EXPECT_THAT(info, HasSubstr("Feature Count: " +
+                                std::to_string(json["features"].size())));
+    EXPECT_THAT(info, HasSubstr("Lambert-93"));
+    if (json["features"].empty()) continue;
+    features_seen += static_cast<int>(json["features"].size());
+    // "Geometry: 3D Line String": one type for the layer, not "Unknown".
+    EXPECT_TRUE(std::regex_search(
+        info, std::regex("Geometry: (3D )?" + std::string(geometry) + "\n")))
+        << info;
+    for (const auto& feature : json["features"]) {
+      EXPECT_EQ(feature["geometry"]["type"],
+                std::regex_replace(geometry, std::regex(" "), ""));
+    }
+    // Lambert-93 eastings, not longitudes.
+    const nlohmann::json* position =
+        &json["features"][0]["geometry"]["coordinates"];
+    while ((*position)[0].is_array()) position = &(*position)[0];
+    EXPECT_GT((*position)[0].get<double>(), 100000.0);
+  }
+  EXPECT_GT(features_seen, 0);
+  // Without output_crs: RFC 7946, longitude and latitude, no "crs".
+  const nlohmann::json plain =
+      nlohmann::json::parse(ReadWholeFile(plain_ + "/" + kMatchesGeoJsonFile));
+  EXPECT_FALSE(plain.contains("crs"));
+  ASSERT_FALSE(plain["features"].empty());
+  EXPECT_LT(
+      std::abs(
+          plain["features"][0]["geometry"]["coordinates"][0][0].get<double>()),
+      180.0);
 }
 
 TEST_F(OutputCrs, ProjectedTrajectoryGivesTheSamePosesToAMillimetre) {
