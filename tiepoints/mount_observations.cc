@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <opencv2/features2d.hpp>
@@ -102,9 +103,35 @@ std::string MountObservationOptions::Check() const {
   if (!(max_epipolar_distance_px > 0.0)) {
     return "max_epipolar_distance_px: must be > 0";
   }
+  if (max_exposures < 0 || (max_exposures > 0 && max_exposures < 2)) {
+    return "max_exposures = " + std::to_string(max_exposures) +
+           ": must be 0 (every exposure) or >= 2";
+  }
+  if (run_length < 2) {
+    return "run_length = " + std::to_string(run_length) + ": must be >= 2";
+  }
   const std::string odometry_problem = odometry.Check();
   if (!odometry_problem.empty()) return "odometry." + odometry_problem;
   return "";
+}
+
+std::vector<bool> SampledExposures(int num_exposures, int max_exposures,
+                                   int run_length) {
+  if (max_exposures == 0 || num_exposures <= max_exposures) {
+    return std::vector<bool>(num_exposures, true);
+  }
+  std::vector<bool> sampled(num_exposures, false);
+  const int length = std::min(run_length, max_exposures);
+  const int runs = max_exposures / length;
+  for (int r = 0; r < runs; ++r) {
+    // Run starts spread from the first exposure to the last full run.
+    const int first =
+        static_cast<int>(runs == 1 ? 0
+                                   : static_cast<long long>(r) *
+                                         (num_exposures - length) / (runs - 1));
+    for (int k = 0; k < length; ++k) sampled[first + k] = true;
+  }
+  return sampled;
 }
 
 MountObservations ObserveMount(const MountObservationOptions& options,
@@ -124,8 +151,15 @@ MountObservations ObserveMount(const MountObservationOptions& options,
   std::vector<Features> previous(rig.stereo_pairs.size());
   std::vector<int> previous_exposure(rig.stereo_pairs.size(), -1);
   std::vector<Eigen::Isometry3d> previous_T_enu_body(rig.stereo_pairs.size());
+  const std::vector<bool> sampled = SampledExposures(
+      num_exposures, options.max_exposures, options.run_length);
   for (int e = 0; e < num_exposures; ++e) {
     cancel.ThrowIfCancelled();
+    if (!sampled[e]) {
+      // The next run's first exposure has no neighbour to measure from.
+      std::fill(previous_exposure.begin(), previous_exposure.end(), -1);
+      continue;
+    }
     const Exposure& exposure = exposures.exposures[e];
     Pose pose;
     const bool has_pose = trajectory.InterpolatePose(exposure.time, &pose);

@@ -34,6 +34,12 @@ struct MountObservationOptions {
   // The motion between exposures; its bounds against the trajectory's
   // motion are wide enough for a mount wrong by several degrees.
   StereoOdometryOptions odometry;
+  // One mount holds for the whole survey: a long survey is sampled, this
+  // many exposures at most, in runs of consecutive ones (the motion is
+  // measured between neighbours) spread evenly along it. 0: every one.
+  int max_exposures = 120;
+  // Consecutive exposures per run of that sample.
+  int run_length = 4;
 
   std::string Check() const;
 };
@@ -64,15 +70,23 @@ struct MountObservations {
   int motion_steps = 0;  // steps tried (both exposures readable)
 };
 
-// Reads every stereo pair's images once. Unreadable images and exposures
-// outside the trajectory are skipped. Throws std::invalid_argument when
-// options.Check() fails, CancelledError between exposures.
+// Reads every stereo pair's images of the sampled exposures once (all of
+// them on a survey of up to options.max_exposures). Unreadable images and
+// exposures outside the trajectory are skipped. Throws std::invalid_argument
+// when options.Check() fails, CancelledError between exposures.
 MountObservations ObserveMount(
     const MountObservationOptions& options, const std::string& survey_folder,
     const Rig& rig, const Trajectory& trajectory,
     const ExposureTable& exposures,
     const std::function<void(int, int)>& progress = nullptr,
     const CancellationToken& cancel = {});
+
+// Which of num_exposures exposures ObserveMount reads: all of them up to
+// max_exposures (or with max_exposures 0), else max_exposures / run_length
+// runs of run_length consecutive exposures, the first run at the survey's
+// start, the last at its end.
+std::vector<bool> SampledExposures(int num_exposures, int max_exposures,
+                                   int run_length);
 
 }  // namespace zebrageo
 

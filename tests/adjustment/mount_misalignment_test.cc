@@ -6,9 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "survey/math_util.h"
+#include "tiepoints/mount_observations.h"
 
 namespace zebrageo {
 namespace {
@@ -129,6 +131,40 @@ TEST(MountMisalignment, RefusesBadOptions) {
   EXPECT_THROW(
       EstimateMountMisalignment(options, StatedRig(), MountObservations()),
       std::invalid_argument);
+}
+
+// A long survey is read in runs of consecutive exposures spread over its
+// whole length, never more than max_exposures of them; a short one whole.
+TEST(MountObservations, SamplesLongSurveysInRunsSpreadAlongThem) {
+  const std::vector<bool> all = SampledExposures(100, 120, 4);
+  EXPECT_EQ(std::count(all.begin(), all.end(), true), 100);
+  const std::vector<bool> every = SampledExposures(5000, 0, 4);
+  EXPECT_EQ(std::count(every.begin(), every.end(), true), 5000);
+  for (const int n : {121, 997, 100000}) {
+    const std::vector<bool> sampled = SampledExposures(n, 120, 4);
+    ASSERT_EQ(static_cast<int>(sampled.size()), n);
+    EXPECT_EQ(std::count(sampled.begin(), sampled.end(), true), 120) << n;
+    EXPECT_TRUE(sampled.front() && sampled.back()) << n;
+    // Runs of at least 4 consecutive exposures (two may touch on a short
+    // survey), with no stretch unsampled longer than the survey's share.
+    int run = 0, gap = 0, longest_gap = 0;
+    for (int e = 0; e < n; ++e) {
+      if (sampled[e]) {
+        ++run;
+        gap = 0;
+      } else {
+        if (run > 0) {
+          EXPECT_GE(run, 4) << n << " exposure " << e;
+        }
+        run = 0;
+        longest_gap = std::max(longest_gap, ++gap);
+      }
+    }
+    EXPECT_LE(longest_gap, n / 29) << n;  // 30 runs: 29 gaps
+  }
+  MountObservationOptions options;
+  options.max_exposures = 1;
+  EXPECT_FALSE(options.Check().empty());
 }
 
 }  // namespace
