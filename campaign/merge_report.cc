@@ -5,6 +5,8 @@
 #include <set>
 #include <sstream>
 
+#include "pipeline/svg_plot.h"
+
 namespace zebrageo {
 namespace {
 
@@ -46,29 +48,6 @@ const MergedBlockView* ViewOf(const MergeReportInputs& inputs, int index) {
   return nullptr;
 }
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string Cell(const json& value) {
   if (value.is_number_float()) {
     std::ostringstream s;
@@ -77,8 +56,8 @@ std::string Cell(const json& value) {
     s << value.get<double>();
     return s.str();
   }
-  if (value.is_string()) return Escape(value.get<std::string>());
-  return Escape(value.dump());
+  if (value.is_string()) return EscapeHtml(value.get<std::string>());
+  return EscapeHtml(value.dump());
 }
 
 // An HTML table of an array of flat objects.
@@ -87,7 +66,7 @@ std::string Table(const json& rows) {
   std::ostringstream s;
   s << "<table><tr>";
   for (const auto& [key, value] : rows[0].items())
-    s << "<th>" << Escape(key) << "</th>";
+    s << "<th>" << EscapeHtml(key) << "</th>";
   s << "</tr>\n";
   for (const json& row : rows) {
     s << "<tr>";
@@ -267,11 +246,11 @@ std::string MergeReportHtml(const nlohmann::json& report) {
   const std::string name = report["survey"]["name"].get<std::string>();
   s << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>zebrageo "
        "campaign: "
-    << Escape(name)
+    << EscapeHtml(name)
     << "</title><style>table{border-collapse:collapse}td,th{border:1px solid "
        "#999;padding:2px 6px}</style></head><body>\n"
-    << "<h1>Campaign " << Escape(report["campaign"].get<std::string>()) << ": "
-    << Escape(name) << "</h1>\n"
+    << "<h1>Campaign " << EscapeHtml(report["campaign"].get<std::string>())
+    << ": " << EscapeHtml(name) << "</h1>\n"
     << "<h2>Counts</h2>" << Table(json::array({report["counts"]}))
     << "<h2>Control and check points</h2>"
     << Table(json::array({report["gcp"]["control"]}))
@@ -282,7 +261,7 @@ std::string MergeReportHtml(const nlohmann::json& report) {
     << Table(report["uncontrolled_stretches"]) << "<h2>Database faults</h2>"
     << Table(report["database_faults"]) << "<h2>Warnings</h2><ul>";
   for (const json& w : report["warnings"]) {
-    s << "<li>" << Escape(w.get<std::string>()) << "</li>";
+    s << "<li>" << EscapeHtml(w.get<std::string>()) << "</li>";
   }
   s << "</ul></body></html>\n";
   return s.str();

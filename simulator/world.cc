@@ -17,6 +17,8 @@ namespace zebrageo::sim {
 
 using world_internal::BuildFacades;
 using world_internal::CastShadows;
+using world_internal::DrawBandRow;
+using world_internal::kBandKerbMarginM;
 using world_internal::kCrossingSeed;
 using world_internal::kDatabaseSeed;
 using world_internal::kMarksSeed;
@@ -37,8 +39,6 @@ namespace {
 // after it, so the cameras see road at the end of the drive.
 constexpr double kLeadInM = 20.0;
 constexpr double kLookAheadM = 150.0;
-// Distance kept between the outer bands and the kerbs.
-constexpr double kBandKerbMarginM = 0.25;
 // Offset of the edge lines from the kerbs.
 constexpr double kEdgeLineInsetM = 0.3;
 
@@ -106,25 +106,7 @@ Crossing DesignCrossing(const SimulationOptions& options, const Road& road,
   c.band_width_m = options.band_width_m;
   c.band_period_m = period;
   const int most = std::min(options.max_bands_per_crossing, fit);
-  const int least = std::min(options.min_bands_per_crossing, most);
-  c.num_design_bands =
-      Bernoulli(rng, 0.6) ? most : UniformInt(rng, least, most);
-  const double width = road.width_m();
-  const double span = c.num_design_bands * options.band_width_m +
-                      (c.num_design_bands - 1) * options.band_gap_m;
-  const double free = width - 2.0 * kBandKerbMarginM - span;
-  c.first_offset_m = -0.5 * width + kBandKerbMarginM +
-                     (free > 0.3 ? Uniform(rng, 0.0, free) : 0.5 * free);
-  for (int k = 0; k < c.num_design_bands; ++k) {
-    c.ring_start.push_back(UniformInt(rng, 0, 3));
-  }
-  const double angle = Uniform(rng, 0.0, 2.0 * kPi);
-  const double magnitude = Uniform(rng, options.database_min_offset_m,
-                                   options.database_max_offset_m);
-  c.db_offset_enu =
-      Eigen::Vector3d(magnitude * std::cos(angle), magnitude * std::sin(angle),
-                      Uniform(rng, -options.database_max_offset_m,
-                              options.database_max_offset_m));
+  DrawBandRow(options, road.width_m(), most, rng, &c);
   return c;
 }
 
@@ -405,6 +387,33 @@ void PlaceSmallMarks(const SimulationOptions& options, World* world) {
 }  // namespace
 
 namespace world_internal {
+
+// The row of bands of crossing c across a street `width` wide: their count
+// (at most `most`), the first one's offset from the street's middle, each
+// band's ring of paint wear, and the database's offset of the crossing
+// (c->band_width_m set). The draws' order is the random preset's contract:
+// a change changes every survey after it.
+void DrawBandRow(const SimulationOptions& options, double width, int most,
+                 std::mt19937_64* rng, Crossing* c) {
+  const int least = std::min(options.min_bands_per_crossing, most);
+  c->num_design_bands =
+      Bernoulli(rng, 0.6) ? most : UniformInt(rng, least, most);
+  const double span = c->num_design_bands * c->band_width_m +
+                      (c->num_design_bands - 1) * options.band_gap_m;
+  const double free = width - 2.0 * kBandKerbMarginM - span;
+  c->first_offset_m = -0.5 * width + kBandKerbMarginM +
+                      (free > 0.3 ? Uniform(rng, 0.0, free) : 0.5 * free);
+  for (int k = 0; k < c->num_design_bands; ++k) {
+    c->ring_start.push_back(UniformInt(rng, 0, 3));
+  }
+  const double angle = Uniform(rng, 0.0, 2.0 * kPi);
+  const double magnitude = Uniform(rng, options.database_min_offset_m,
+                                   options.database_max_offset_m);
+  c->db_offset_enu =
+      Eigen::Vector3d(magnitude * std::cos(angle), magnitude * std::sin(angle),
+                      Uniform(rng, -options.database_max_offset_m,
+                              options.database_max_offset_m));
+}
 
 std::vector<std::pair<double, double>> Subtract(
     double s0, double s1, std::vector<std::pair<double, double>> holes) {

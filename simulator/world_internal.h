@@ -6,6 +6,7 @@
 #define ZEBRAGEO_SIMULATOR_WORLD_INTERNAL_H_
 
 #include <cstdint>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -26,6 +27,10 @@ enum Purpose : uint64_t {
   kTextureSeed = 9,
 };
 
+// Distance kept between a crossing's outer bands and the kerbs of the
+// street it spans.
+constexpr double kBandKerbMarginM = 0.25;
+
 // The s-intervals of [s0, s1] left after removing `holes` (sorted, merged).
 std::vector<std::pair<double, double>> Subtract(
     double s0, double s1, std::vector<std::pair<double, double>> holes);
@@ -39,6 +44,11 @@ bool NearCrossing(const World& world, double s0, double s1, double margin);
 
 // Side streets and the crossings across them (world_junctions.cc), after
 // the road's crossings, from their own generator.
+// Crossing c's row of bands across a street `width` wide, at most `most`
+// of them, and its database offset (world.cc: the random preset's draws).
+void DrawBandRow(const SimulationOptions& options, double width, int most,
+                 std::mt19937_64* rng, Crossing* c);
+
 void PlaceJunctions(const SimulationOptions& options, World* world);
 // Buildings cut back from the side streets' mouths (world_junctions.cc).
 void OpenFacadesAtJunctions(const SimulationOptions& options, World* world);

@@ -19,12 +19,12 @@
 namespace zebrageo::sim {
 namespace {
 
+using world_internal::DrawBandRow;
+using world_internal::kBandKerbMarginM;
 using world_internal::kJunctionSeed;
 
 constexpr double kSideStreetLengthM = 60.0;
-// Distance kept between a crossing's outer bands and the side street's
-// kerbs, and between a junction's mouth and the road's crossings.
-constexpr double kBandKerbMarginM = 0.25;
+// Distance kept between a junction's mouth and the road's crossings.
 constexpr double kMouthClearanceM = 4.0;
 
 // The road s-range of the mouth of a side street at the road's kerb line.
@@ -95,24 +95,7 @@ Crossing DesignSideCrossing(const SimulationOptions& options,
   const int fit = static_cast<int>(std::floor(
       (width - 2.0 * kBandKerbMarginM + options.band_gap_m) / c.band_period_m));
   const int most = std::max(1, std::min(options.max_bands_per_crossing, fit));
-  const int least = std::min(options.min_bands_per_crossing, most);
-  c.num_design_bands =
-      Bernoulli(rng, 0.6) ? most : UniformInt(rng, least, most);
-  const double span = c.num_design_bands * c.band_width_m +
-                      (c.num_design_bands - 1) * options.band_gap_m;
-  const double free = width - 2.0 * kBandKerbMarginM - span;
-  c.first_offset_m = -0.5 * width + kBandKerbMarginM +
-                     (free > 0.3 ? Uniform(rng, 0.0, free) : 0.5 * free);
-  for (int k = 0; k < c.num_design_bands; ++k) {
-    c.ring_start.push_back(UniformInt(rng, 0, 3));
-  }
-  const double angle = Uniform(rng, 0.0, 2.0 * kPi);
-  const double magnitude = Uniform(rng, options.database_min_offset_m,
-                                   options.database_max_offset_m);
-  c.db_offset_enu =
-      Eigen::Vector3d(magnitude * std::cos(angle), magnitude * std::sin(angle),
-                      Uniform(rng, -options.database_max_offset_m,
-                              options.database_max_offset_m));
+  DrawBandRow(options, width, most, rng, &c);
   // The near ends of the bands `setback` or more beyond the road's kerb
   // line: at offset o across the side street the kerb line is at
   // half / cos(angle) - side o tan(angle) along it, the near end at
