@@ -6,25 +6,12 @@
 #include <sstream>
 
 #include "pipeline/svg_plot.h"
+#include "survey/math_util.h"
 
 namespace zebrageo {
 namespace {
 
 using json = nlohmann::json;
-
-constexpr double kRadToDeg = 180.0 / M_PI;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double Rms(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x * x;
-  return v.empty() ? 0.0 : std::sqrt(sum / v.size());
-}
 
 // The database's accuracy at the crossings named (all of them if none).
 void DatabaseSigmas(const RoadmarkDatabase& db,
@@ -97,8 +84,7 @@ json SeamFigures(const MergeReportInputs& inputs) {
       const Pose& pa = a->corrected->poses()[i - a->block->first_sample];
       const Pose& pb = b->corrected->poses()[i - b->block->first_sample];
       const Eigen::Vector3d d = pa.p_enu - pb.p_enu;
-      const double att =
-          pa.q_enu_body.angularDistance(pb.q_enu_body) * kRadToDeg;
+      const double att = RadToDeg(pa.q_enu_body.angularDistance(pb.q_enu_body));
       max_h = std::max(max_h, d.head<2>().norm());
       max_v = std::max(max_v, std::abs(d.z()));
       max_att = std::max(max_att, att);
