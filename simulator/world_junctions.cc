@@ -100,15 +100,8 @@ Crossing DesignSideCrossing(const SimulationOptions& options,
   // line: at offset o across the side street the kerb line is at
   // half / cos(angle) - side o tan(angle) along it, the near end at
   // along - L / 2 + o tan_skew.
-  // Log-uniform: most such crossings sit at the mouth (a car's length or
-  // less back, where pedestrians walk along the road's pavement), few far
-  // up the side street; a uniform draw put half of them 5-10 m back, where
-  // a forward camera never sees a band whole within 15 m.
-  // (Log-uniform in setback + 1 m: the bounds may start at 0.)
-  const double setback =
-      std::exp(Uniform(rng, std::log(options.min_side_crossing_setback_m + 1.0),
-                       std::log(options.max_side_crossing_setback_m + 1.0))) -
-      1.0;
+  const double setback = Uniform(rng, options.min_side_crossing_setback_m,
+                                 options.max_side_crossing_setback_m);
   const double kerb = 0.5 * road.width_m() / std::cos(street.angle_rad);
   const double lean =
       0.5 * width *
