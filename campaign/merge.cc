@@ -125,14 +125,29 @@ std::vector<TrajectorySample> MergedTrajectory(
 // poses.csv: one row per image any block has, blended likewise.
 std::vector<CameraPose> MergedPoses(const Survey& survey,
                                     const std::vector<BlockOutputs>& blocks) {
+  // A block holds the images within its times only, and the blocks follow
+  // each other in time: those holding an image are found by binary search
+  // (a long survey's thousands of blocks are not all asked per image).
+  std::vector<double> starts;
+  for (const BlockOutputs& b : blocks) starts.push_back(b.block->start_time);
   std::vector<CameraPose> merged;
   for (const ExposureImage& image : survey.exposures.images) {
     const std::string camera =
         survey.rig.cameras.at(image.camera).camera.name();
+    const int last =
+        static_cast<int>(
+            std::upper_bound(starts.begin(), starts.end(), image.time) -
+            starts.begin()) -
+        1;
+    int first = last + 1;
+    while (first > 0 && blocks[first - 1].block->end_time >= image.time) {
+      --first;
+    }
     CameraPose result;
     Pose pose;
     double weight = 0.0;
-    for (const BlockOutputs& b : blocks) {
+    for (int k = first; k <= last; ++k) {
+      const BlockOutputs& b = blocks[k];
       const auto it = b.poses.find({image.exposure_id, camera});
       if (it == b.poses.end()) continue;
       const double w = std::max(b.Weight(image.time), 1e-12);
