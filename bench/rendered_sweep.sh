@@ -45,7 +45,7 @@ for seed in $seeds; do
   if [[ ! -f "$survey/survey.yaml" ]]; then
     rm -rf "$survey"
     "$zebrageo" --log-level error simulate --preset random --seed "$seed" \
-      --max-road-length "$max_length" ${JUNCTIONS:+--set "num_junctions=$JUNCTIONS"} \
+      --max-road-length "$max_length" ${JUNCTIONS:+--junctions "$JUNCTIONS"} \
       -o "$survey"
   fi
   rm -rf "$results"

@@ -401,6 +401,15 @@ std::string ApplyPreset(const std::string& name, SimulationOptions* options) {
     o.drift_along_track_m = 0.8;
     o.drift_cross_track_m = 0.5;
     o.drift_vertical_m = 0.15;
+    // A wide-angle rig (85 degrees across, the default lens's distortion as
+    // a function of the pixel radius), as the random preset has with
+    // junctions: the side streets' crossings whole in view within 15 m.
+    const double focal = 0.5 * o.image_width / std::tan(DegToRad(42.5));
+    const double scale2 = (focal / o.focal_px) * (focal / o.focal_px);
+    o.k1 *= scale2;
+    o.k2 *= scale2 * scale2;
+    o.k3 *= scale2 * scale2 * scale2;
+    o.focal_px = focal;
   } else if (name == "large") {
     o.road_length_m = 10000.0;
     o.num_crossings = 80;

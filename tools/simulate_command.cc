@@ -24,6 +24,7 @@ struct SimulateArguments {
   bool no_images = false;
   std::string bad;
   double max_road_length_m = RandomPresetLimits().max_road_length_m;
+  int junctions = RandomPresetLimits().junctions;
 };
 
 }  // namespace
@@ -51,6 +52,11 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--max-road-length", args->max_road_length_m,
                   "random preset: the longest road drawn, metres (from 60)")
       ->capture_default_str();
+  sub->add_option("--junctions", args->junctions,
+                  "random preset: this many junctions (side streets with "
+                  "crossings across them, drawn as the preset draws them); "
+                  "-1 drawn (half the surveys)")
+      ->capture_default_str();
   sub->add_flag("--no-images", args->no_images,
                 "write only the geometry (no rendering)");
   commands->push_back(
@@ -62,6 +68,7 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
          if (args->preset == "random") {
            RandomPresetLimits limits;
            limits.max_road_length_m = args->max_road_length_m;
+           limits.junctions = args->junctions;
            error = DrawRandomOptions(args->seed, limits, &options);
          } else {
            error = ApplyPreset(args->preset, &options);

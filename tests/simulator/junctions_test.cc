@@ -153,6 +153,8 @@ TEST(Junctions, RandomPresetDrawsThemInHalfTheSurveysOnly) {
     EXPECT_EQ(o.drift_along_track_m, p.drift_along_track_m);
     if (o.num_junctions == 0) {
       EXPECT_EQ(o.four_way_probability, p.four_way_probability);
+      EXPECT_EQ(o.focal_px, p.focal_px);
+      EXPECT_EQ(o.k1, p.k1);
     }
   }
   EXPECT_GT(with, 15);

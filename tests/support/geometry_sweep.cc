@@ -98,6 +98,7 @@ void ScoreMatches(const sim::SimulatedSurvey& simulated,
     if (!crossing.repainted) ++result->consistent_crossings;
     if (matched.count(crossing.id) == 0) continue;
     ++result->crossings_matched;
+    result->matched_crossings.push_back(crossing.id);
     ++(crossing.repainted ? result->repainted_matched
                           : result->consistent_matched);
   }
@@ -142,6 +143,8 @@ void ScorePoses(const sim::SimulatedSurvey& simulated, const Survey& survey,
       if (it == after.end()) continue;
       after_errors.Add(T_true, it->second->p_enu,
                        it->second->q_enu_cam.toRotationMatrix());
+      result->h_after_by_image.push_back(
+          {image.time, T_true.translation(), after_errors.h.back()});
     }
   }
   result->cameras = static_cast<int>(before_errors.h.size());

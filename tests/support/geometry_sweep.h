@@ -23,6 +23,7 @@
 #ifndef ZEBRAGEO_TESTS_SUPPORT_GEOMETRY_SWEEP_H_
 #define ZEBRAGEO_TESTS_SUPPORT_GEOMETRY_SWEEP_H_
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -118,6 +119,16 @@ struct GeometryRunResult {
   bool worse_attitude = false;
   // Stretches where the guard kept the input (control_guard.h).
   int input_kept_stretches = 0;
+  // Crossings with a right match kept as control (crossing_id), and per
+  // image after the adjustment (when usable): its time, its camera's true
+  // position (ENU) and its horizontal error (metres).
+  std::vector<std::string> matched_crossings;
+  struct ImageError {
+    double time = 0.0;
+    Eigen::Vector3d p_true_enu = Eigen::Vector3d::Zero();
+    double h_m = 0.0;
+  };
+  std::vector<ImageError> h_after_by_image;
   double seconds = 0.0;
 
   // "exit 3" while a consistent set of crossings exists.
