@@ -36,7 +36,9 @@ std::string BoresightCheckOptions::Check() const {
   if (!(max_observed_sd_rad >= max_applied_sd_rad)) {
     return "max_observed_sd_rad: must be >= max_applied_sd_rad";
   }
-  std::string problem = observations.Check();
+  std::string problem = attitude.Check();
+  if (!problem.empty()) return "attitude." + problem;
+  problem = observations.Check();
   if (!problem.empty()) return "observations." + problem;
   problem = estimate.Check();
   if (!problem.empty()) return "estimate." + problem;
