@@ -170,10 +170,14 @@ TEST(SmallMountYaw, EndsNoWorseThanTheInputOrExits1) {
       Eigen::AngleAxisd(DegToRad(0.3), Eigen::Vector3d::UnitZ()).matrix(),
       survey);
   const std::string results = folder.Path("results");
-  const int code =
-      RunZebrageo("--log-level warning run " + Quote(survey) + " -o " +
-                      Quote(results) + " --threads 2 --allow-outside-paths",
-                  folder.Path("out"), folder.Path("err"));
+  // The second look after the adjustment (off by default:
+  // pipeline/mount_attitude_check.h).
+  const std::string options = folder.Path("options.json");
+  std::ofstream(options) << R"({"boresight": {"attitude": {"enabled": true}}})";
+  const int code = RunZebrageo(
+      "--log-level warning run " + Quote(survey) + " -o " + Quote(results) +
+          " --options " + Quote(options) + " --threads 2 --allow-outside-paths",
+      folder.Path("out"), folder.Path("err"));
   const std::string err = ReadWholeFile(folder.Path("err"));
   std::cout << err;
   ASSERT_TRUE(code == 0 || code == 1) << code << ": " << err;
