@@ -126,6 +126,10 @@ std::string RigCalibrationOptions::Check() const {
 std::string CovarianceOptions::Check() const {
   OptionCheck check;
   OPTION_GE(check, max_knots_for_covariance, 0);
+  OPTION_GT(check, weak_sd_database_factor, 0.0);
+  OPTION_GT(check, weak_sd_floor_m, 0.0);
+  OPTION_GT(check, weak_control_radius_m, 0.0);
+  OPTION_GT(check, weak_min_length_m, 0.0);
   return check.problem();
 }
 

@@ -334,15 +334,33 @@ struct RigCalibrationOptions {
 
 // Posterior covariance of the corrected positions (trajectory sd_* of the
 // output) when the problem has at most max_knots_for_covariance knots.
+// From it, the stretches where one axis (along-track, cross-track, up) is
+// weakly held (issue 51): its posterior sd above weak_sd_database_factor
+// times the database's stated sd of that axis (the median sigma_xy of the
+// zebra bands for along and cross, sigma_z for up), and never below
+// weak_sd_floor_m, or no control holding it within weak_control_radius_m
+// (zebra control vertices hold every axis; road-line points hold
+// cross-track and height, along-track only those across the track or on a
+// dash's ends), over at least weak_min_length_m of trajectory. The sd alone
+// is not enough: the error model estimated from a few crossings can be
+// tighter than the drift between them.
 struct CovarianceOptions {
   bool compute_covariance = true;
   int max_knots_for_covariance = 3000;
+  double weak_sd_database_factor = 2.0;
+  double weak_sd_floor_m = 0.1;
+  double weak_control_radius_m = 30.0;
+  double weak_min_length_m = 30.0;
 
   std::string Check() const;
   template <typename Visitor>
   void VisitFields(Visitor& v) {
     v("compute_covariance", compute_covariance);
     v("max_knots_for_covariance", max_knots_for_covariance);
+    v("weak_sd_database_factor", weak_sd_database_factor);
+    v("weak_sd_floor_m", weak_sd_floor_m);
+    v("weak_control_radius_m", weak_control_radius_m);
+    v("weak_min_length_m", weak_min_length_m);
   }
 };
 

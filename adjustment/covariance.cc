@@ -11,9 +11,9 @@
 namespace zebrageo {
 namespace adjustment_internal {
 
-std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
-                                              State* state,
-                                              AdjustmentProblem* problem) {
+std::vector<Eigen::Matrix3d> SampleCovariance(
+    const Context& context, State* state, AdjustmentProblem* problem,
+    std::vector<Eigen::Vector3d>* sd_track_m) {
   const AdjustmentOptions& options = context.options;
   const Trajectory& trajectory = *context.input.trajectory;
   std::vector<Eigen::Matrix3d> sample_covariance;
@@ -43,6 +43,7 @@ std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
   const double sigma0 = context.summary->sigma0;
   const double scale = std::max(1.0, sigma0 * sigma0);
   sample_covariance.reserve(trajectory.size());
+  if (sd_track_m != nullptr) sd_track_m->clear();
   // An along-track correction held at the input keeps the input's
   // uncertainty, which the lines' error model sizes (State::
   // along_track_held).
@@ -69,6 +70,9 @@ std::vector<Eigen::Matrix3d> SampleCovariance(const Context& context,
       }
     }
     C(0, 0) += held_along_variance;
+    if (sd_track_m != nullptr) {
+      sd_track_m->push_back((scale * C).diagonal().cwiseMax(0.0).cwiseSqrt());
+    }
     // The knots are in the track frame at each sample (along-track, left,
     // up): the samples' sd_* are east, north, up.
     const Eigen::Matrix3d R_enu_track =

@@ -15,8 +15,11 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -109,6 +112,129 @@ void SelectControl(const Context& context, const CrossingTable& crossings,
       adjustment_internal::AlongTrackHeld(context.options, *state);
 }
 
+// Per sample and axis (along, cross, up): whether a control holds it within
+// `radius_m` of trajectory. A zebra control vertex holds every axis of the
+// samples within radius_m of it; a road-line point the axis its residual
+// measures (across_enu: cross-track for a lane line, along-track for a line
+// across the track or a dash's ends) and the height, at the samples within
+// radius_m along the trajectory of where it was seen.
+std::vector<std::array<bool, 3>> HeldAxes(const Context& context,
+                                          const AdjustmentResult& result,
+                                          const std::vector<double>& times,
+                                          const std::vector<Eigen::Vector3d>& p,
+                                          double radius_m) {
+  const int n = static_cast<int>(times.size());
+  std::vector<std::array<bool, 3>> held(n, {false, false, false});
+  std::vector<Eigen::Vector2d> crossings;  // one control vertex each
+  std::set<std::string> seen;
+  for (const ControlPointResult& c : result.control_points) {
+    if (c.status == ControlStatus::kControl &&
+        seen.insert(c.crossing_id).second) {
+      crossings.push_back(c.database_enu.head<2>());
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (const Eigen::Vector2d& c : crossings) {
+      if ((p[i].head<2>() - c).norm() <= radius_m) {
+        held[i] = {true, true, true};
+        break;
+      }
+    }
+  }
+  if (context.input.line_points == nullptr || n == 0) return held;
+  std::vector<double> distance(n, 0.0);
+  for (int i = 1; i < n; ++i) {
+    distance[i] = distance[i - 1] + (p[i] - p[i - 1]).norm();
+  }
+  // Per axis, the intervals of trajectory distance a line point holds.
+  std::array<std::vector<std::pair<double, double>>, 3> spans;
+  for (const LineControlPoint& point : *context.input.line_points) {
+    const int i = static_cast<int>(
+        std::lower_bound(times.begin(), times.end(), point.time) -
+        times.begin());
+    if (i <= 0 || i >= n) continue;
+    Eigen::Vector3d ahead = p[i] - p[i - 1];
+    ahead.z() = 0.0;
+    if (ahead.norm() < 1e-6) continue;
+    const bool along = std::abs(point.across_enu.dot(ahead.normalized())) > 0.7;
+    const std::pair<double, double> span = {distance[i] - radius_m,
+                                            distance[i] + radius_m};
+    spans[along ? 0 : 1].push_back(span);
+    spans[2].push_back(span);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    std::sort(spans[axis].begin(), spans[axis].end());
+    size_t k = 0;
+    double reach = -1e300;
+    for (int i = 0; i < n; ++i) {
+      while (k < spans[axis].size() && spans[axis][k].first <= distance[i]) {
+        reach = std::max(reach, spans[axis][k].second);
+        ++k;
+      }
+      if (distance[i] <= reach) held[i][axis] = true;
+    }
+  }
+  return held;
+}
+
+// The stretches where an axis is weakly held (CovarianceOptions::weak_*),
+// each also a warning: thresholds from the database's stated accuracy,
+// positions of the corrected trajectory.
+std::vector<WeakStretch> WeakStretchesOf(
+    const Context& context, const AdjustmentResult& result,
+    const std::vector<Eigen::Vector3d>& sd_track_m) {
+  const CovarianceOptions& options = context.options.covariance;
+  std::vector<double> sigma_xy, sigma_z;
+  if (context.input.roadmarks != nullptr) {
+    for (const RoadmarkBand& band : context.input.roadmarks->bands) {
+      sigma_xy.push_back(band.sigma_xy_m);
+      if (band.height_known) sigma_z.push_back(band.sigma_z_m);
+    }
+  }
+  const double xy = options.weak_sd_database_factor * Median(sigma_xy);
+  const double z = options.weak_sd_database_factor * Median(sigma_z);
+  const Eigen::Vector3d threshold(std::max(options.weak_sd_floor_m, xy),
+                                  std::max(options.weak_sd_floor_m, xy),
+                                  std::max(options.weak_sd_floor_m, z));
+  std::vector<double> times;
+  std::vector<Eigen::Vector3d> positions;
+  for (size_t i = 0; i < result.corrected_samples.size(); ++i) {
+    times.push_back(result.corrected_samples[i].time);
+    positions.push_back(result.corrected_poses[i].p_enu);
+  }
+  const std::vector<WeakStretch> stretches = adjustment_internal::WeakStretches(
+      times, positions, sd_track_m,
+      HeldAxes(context, result, times, positions,
+               options.weak_control_radius_m),
+      threshold, options.weak_min_length_m);
+  for (const WeakStretch& s : stretches) {
+    const char* axis = s.axis == TrackAxis::kAlongTrack   ? "along-track"
+                       : s.axis == TrackAxis::kCrossTrack ? "cross-track"
+                                                          : "height";
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(0) << "the " << axis
+         << " position is held by no control over " << s.length_m
+         << " m of trajectory (t = " << s.begin_time_s << " to " << s.end_time_s
+         << " s)";
+    if (!s.held_by_no_control) {
+      text << std::setprecision(2) << ": posterior sd above " << s.threshold_m
+           << " m";
+    } else if (s.axis == TrackAxis::kAlongTrack) {
+      text << ": no zebra crossing within " << options.weak_control_radius_m
+           << " m and no road line across the track";
+    } else {
+      text << ": no zebra crossing or road line within "
+           << options.weak_control_radius_m << " m";
+    }
+    if (std::isfinite(s.max_sd_m)) {
+      text << std::setprecision(2) << "; its posterior sd there up to "
+           << s.max_sd_m << " m (median " << s.median_sd_m << " m)";
+    }
+    context.Warn(text.str());
+  }
+  return stretches;
+}
+
 }  // namespace
 
 AdjustmentResult AdjustTrajectory(const AdjustmentOptions& options,
@@ -192,12 +318,16 @@ AdjustmentResult AdjustTrajectory(const AdjustmentOptions& options,
   output.adjusted = adjusted;
   output.warn = [&context](const std::string& w) { context.Warn(w); };
   output.guard = guard.Fired() ? &guard : nullptr;
+  std::vector<Eigen::Vector3d> sd_track;
   if (adjusted) {
     output.sample_covariance = adjustment_internal::SampleCovariance(
-        context, &state, solver.problem());
+        context, &state, solver.problem(), &sd_track);
   }
   if (!adjustment_internal::FillOutputs(output, &state, &result)) {
     return result;
+  }
+  if (adjusted) {
+    summary.weak_stretches = WeakStretchesOf(context, result, sd_track);
   }
   adjustment_internal::SummariseFinalState(output, state, before, after,
                                            crab_before_deg, &summary);

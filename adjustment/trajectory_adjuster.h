@@ -50,6 +50,7 @@
 #include "adjustment/control_guard.h"
 #include "adjustment/line_costs.h"
 #include "adjustment/trajectory_correction.h"
+#include "adjustment/weak_control.h"
 #include "survey/cancellation.h"
 #include "survey/exposures.h"
 #include "survey/geodesy.h"
@@ -185,6 +186,9 @@ struct AdjustmentSummary {
   double median_posterior_sd_horizontal_m = 0.0;
   double median_posterior_sd_vertical_m = 0.0;
   bool covariance_computed = false;
+  // Stretches where an axis' posterior sd exceeds its threshold
+  // (CovarianceOptions::weak_sd_*; empty without the covariance).
+  std::vector<WeakStretch> weak_stretches;
   // Whether the trajectory was corrected (else the poses are the input's),
   // and whether road lines were its only control (no zebra crossing: the
   // along-track position is the input's unless crossing edges hold it).

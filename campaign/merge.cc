@@ -99,33 +99,25 @@ BlockOutputs ReadBlock(const Campaign& campaign, const CampaignBlock& block,
 // The trajectory: each sample blended from the blocks holding it.
 std::vector<TrajectorySample> MergedTrajectory(
     const Survey& survey, const std::vector<BlockOutputs>& blocks) {
-  std::vector<TrajectorySample> merged;
   const std::vector<TrajectorySample>& input = survey.trajectory.samples();
-  for (int i = 0; i < survey.trajectory.size(); ++i) {
-    const double t = input[i].time;
-    Pose pose;
-    double weight = 0.0;
-    const TrajectorySample* dominant = nullptr;
-    double dominant_weight = -1.0;
-    for (const BlockOutputs& b : blocks) {
-      if (i < b.block->first_sample || i > b.block->last_sample) continue;
-      const int k = i - b.block->first_sample;
-      // The ends of the survey belong to its first and last block whole.
-      const double w = std::max(b.Weight(t), 1e-12);
-      pose = weight == 0.0 ? b.corrected.poses()[k]
-                           : Blend(pose, weight, b.corrected.poses()[k], w);
-      weight += w;
-      if (w > dominant_weight) {
-        dominant_weight = w;
-        dominant = &b.corrected.samples()[k];
-      }
-    }
-    if (dominant == nullptr) {
-      throw UsageError("merge: trajectory sample " + std::to_string(i) +
-                       " is in no block (campaign.json damaged?)");
-    }
-    merged.push_back(SampleFromPose(t, pose, survey.frame, dominant->sd_enu_m,
-                                    dominant->sd_attitude_rad));
+  std::vector<double> times;
+  times.reserve(input.size());
+  for (const TrajectorySample& s : input) times.push_back(s.time);
+  std::vector<BlockPoses> views;
+  for (const BlockOutputs& b : blocks) {
+    views.push_back(
+        {b.block, b.before_end, b.after_start, &b.corrected.poses()});
+  }
+  std::vector<int> dominant;
+  const std::vector<Pose> poses = BlendBlockPoses(times, views, &dominant);
+  std::vector<TrajectorySample> merged;
+  merged.reserve(input.size());
+  for (size_t i = 0; i < input.size(); ++i) {
+    const BlockOutputs& b = blocks[dominant[i]];
+    const TrajectorySample& own =
+        b.corrected.samples()[static_cast<int>(i) - b.block->first_sample];
+    merged.push_back(SampleFromPose(times[i], poses[i], survey.frame,
+                                    own.sd_enu_m, own.sd_attitude_rad));
   }
   return merged;
 }
@@ -133,14 +125,29 @@ std::vector<TrajectorySample> MergedTrajectory(
 // poses.csv: one row per image any block has, blended likewise.
 std::vector<CameraPose> MergedPoses(const Survey& survey,
                                     const std::vector<BlockOutputs>& blocks) {
+  // A block holds the images within its times only, and the blocks follow
+  // each other in time: those holding an image are found by binary search
+  // (a long survey's thousands of blocks are not all asked per image).
+  std::vector<double> starts;
+  for (const BlockOutputs& b : blocks) starts.push_back(b.block->start_time);
   std::vector<CameraPose> merged;
   for (const ExposureImage& image : survey.exposures.images) {
     const std::string camera =
         survey.rig.cameras.at(image.camera).camera.name();
+    const int last =
+        static_cast<int>(
+            std::upper_bound(starts.begin(), starts.end(), image.time) -
+            starts.begin()) -
+        1;
+    int first = last + 1;
+    while (first > 0 && blocks[first - 1].block->end_time >= image.time) {
+      --first;
+    }
     CameraPose result;
     Pose pose;
     double weight = 0.0;
-    for (const BlockOutputs& b : blocks) {
+    for (int k = first; k <= last; ++k) {
+      const BlockOutputs& b = blocks[k];
       const auto it = b.poses.find({image.exposure_id, camera});
       if (it == b.poses.end()) continue;
       const double w = std::max(b.Weight(image.time), 1e-12);
@@ -257,6 +264,41 @@ double BlockWeight(double t, double start_time, double end_time,
                           (end_time - *after_overlap_start));
   }
   return w;
+}
+
+std::vector<Pose> BlendBlockPoses(const std::vector<double>& times,
+                                  const std::vector<BlockPoses>& blocks,
+                                  std::vector<int>* dominant) {
+  const int n = static_cast<int>(times.size());
+  std::vector<Pose> poses(n);
+  std::vector<double> weight(n, 0.0), best(n, -1.0);
+  dominant->assign(n, -1);
+  for (size_t k = 0; k < blocks.size(); ++k) {
+    const BlockPoses& b = blocks[k];
+    const int first = std::max(0, b.block->first_sample);
+    const int last = std::min(n - 1, b.block->last_sample);
+    for (int i = first; i <= last; ++i) {
+      const Pose& pose = (*b.poses)[i - b.block->first_sample];
+      // The ends of the survey belong to its first and last block whole.
+      const double w =
+          std::max(BlockWeight(times[i], b.block->start_time, b.block->end_time,
+                               b.before_overlap_end, b.after_overlap_start),
+                   1e-12);
+      poses[i] = weight[i] == 0.0 ? pose : Blend(poses[i], weight[i], pose, w);
+      weight[i] += w;
+      if (w > best[i]) {
+        best[i] = w;
+        (*dominant)[i] = static_cast<int>(k);
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    if ((*dominant)[i] < 0) {
+      throw UsageError("merge: trajectory sample " + std::to_string(i) +
+                       " is in no block (campaign.json damaged?)");
+    }
+  }
+  return poses;
 }
 
 json MergeCampaign(const std::string& campaign_folder,

@@ -21,6 +21,10 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
+
+#include "campaign/campaign.h"
+#include "survey/trajectory.h"
 
 namespace zebrageo {
 
@@ -31,6 +35,26 @@ inline constexpr char kCampaignReportFile[] = "campaign_report.json";
 double BlockWeight(double t, double start_time, double end_time,
                    const double* before_overlap_end,
                    const double* after_overlap_start);
+
+// One block's corrected body poses at the survey's trajectory samples
+// block->first_sample .. block->last_sample, and its overlaps (null when
+// none): what the merge blends.
+struct BlockPoses {
+  const CampaignBlock* block = nullptr;
+  const double* before_overlap_end = nullptr;
+  const double* after_overlap_start = nullptr;
+  const std::vector<Pose>* poses = nullptr;
+};
+
+// The survey's trajectory from its blocks (in campaign order): at each
+// sample (`times`, the survey's sample times) the blocks holding it
+// blended with their BlockWeight, positions lerped and attitudes slerped.
+// dominant[i] is the index into `blocks` of the block weighing most at
+// sample i. Linear in the blocks' samples (a long survey's many blocks do
+// not multiply). Throws UsageError for a sample no block holds.
+std::vector<Pose> BlendBlockPoses(const std::vector<double>& times,
+                                  const std::vector<BlockPoses>& blocks,
+                                  std::vector<int>* dominant);
 
 // Merges every block (all must be done: block.json) into `results_folder`.
 // Returns the campaign report. Throws UsageError for a block not done or a

@@ -48,8 +48,10 @@ int SampleAtOrAfter(const std::vector<double>& arc, double s) {
                   static_cast<int>(it - arc.begin()));
 }
 
-void AddSurveyBlocks(const Survey& survey, int survey_index,
-                     const PlanOptions& options, Campaign* campaign) {
+}  // namespace
+
+void PlanSurveyBlocks(const Survey& survey, int survey_index,
+                      const PlanOptions& options, Campaign* campaign) {
   const std::vector<double> arc = ArcLengths(survey.trajectory);
   const std::vector<CrossingSpan> spans =
       CrossingSpansAlong(survey.trajectory, arc, survey.roadmarks, survey.frame,
@@ -74,10 +76,14 @@ void AddSurveyBlocks(const Survey& survey, int survey_index,
     b.end_m = arc[b.last_sample];
     b.start_time = survey.trajectory.samples()[b.first_sample].time;
     b.end_time = survey.trajectory.samples()[b.last_sample].time;
-    for (const Exposure& e : survey.exposures.exposures) {
-      if (e.time < b.start_time || e.time > b.end_time) continue;
+    // Exposures are sorted by time: the block's are a range.
+    const std::vector<Exposure>& exposures = survey.exposures.exposures;
+    auto e = std::lower_bound(
+        exposures.begin(), exposures.end(), b.start_time,
+        [](const Exposure& x, double t) { return x.time < t; });
+    for (; e != exposures.end() && e->time <= b.end_time; ++e) {
       ++b.exposures;
-      for (int image : e.image_of_camera) b.images += image >= 0;
+      for (int image : e->image_of_camera) b.images += image >= 0;
     }
     b.crossings = static_cast<int>(
         CrossingsInside(spans, b.start_m, b.end_m, options).size());
@@ -103,8 +109,6 @@ void AddSurveyBlocks(const Survey& survey, int survey_index,
     campaign->overlaps.push_back(o);
   }
 }
-
-}  // namespace
 
 Campaign PlanCampaign(const std::vector<std::string>& survey_folders,
                       const std::string& campaign_folder,
@@ -147,8 +151,8 @@ Campaign PlanCampaign(const std::vector<std::string>& survey_folders,
     entry.samples = survey.trajectory.size();
     entry.images = static_cast<int>(survey.exposures.images.size());
     campaign.surveys.push_back(entry);
-    AddSurveyBlocks(survey, static_cast<int>(campaign.surveys.size()) - 1,
-                    campaign.options, &campaign);
+    PlanSurveyBlocks(survey, static_cast<int>(campaign.surveys.size()) - 1,
+                     campaign.options, &campaign);
     LOG(INFO) << "plan: " << campaign.surveys.back().name << ": "
               << campaign.surveys.back().length_m << " m, "
               << campaign.surveys.back().crossings << " crossings";

@@ -9,6 +9,7 @@
 
 #include "campaign/campaign.h"
 #include "pipeline/run_options.h"
+#include "survey/survey.h"
 
 namespace zebrageo {
 
@@ -20,6 +21,13 @@ Campaign PlanCampaign(const std::vector<std::string>& survey_folders,
                       const std::string& campaign_folder,
                       const PlanOptions& options,
                       const RunOptions& run_options);
+
+// Appends to `campaign` the blocks and overlaps of `survey`, its
+// campaign->surveys[survey_index] (length and crossings set there): the
+// geometry of PlanCampaign, in memory (bench/campaign_bench plans a
+// geometry-level campaign with it).
+void PlanSurveyBlocks(const Survey& survey, int survey_index,
+                      const PlanOptions& options, Campaign* campaign);
 
 // The options every block runs with (CAMPAIGN/options.json).
 RunOptions CampaignRunOptions(const std::string& campaign_folder);

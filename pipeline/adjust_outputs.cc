@@ -156,6 +156,11 @@ AdjustmentRecord AdjustmentRecordOf(const AdjustmentData& data,
   r.posterior_sd_computed = s.covariance_computed;
   r.median_posterior_sd_horizontal_m = s.median_posterior_sd_horizontal_m;
   r.median_posterior_sd_vertical_m = s.median_posterior_sd_vertical_m;
+  for (const WeakStretch& w : s.weak_stretches) {
+    r.weakly_held.push_back({TrackAxisName(w.axis), w.begin_time_s,
+                             w.end_time_s, w.length_m, w.threshold_m,
+                             w.max_sd_m, w.median_sd_m, w.held_by_no_control});
+  }
   for (const ControlPointResult& p : result.control_points) {
     if (p.status != ControlStatus::kRejected) continue;
     r.rejected.push_back({p.crossing_id, p.band, p.db_vertex,

@@ -363,12 +363,29 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   html << "<h2>Reprojection residuals per camera</h2>\n"
        << CameraResidualSection(data);
   html << "<h2>Crossings</h2>\n" << ArrayTable(report["crossings"]);
+  html << "<h2>Database crossings in view</h2>\n"
+       << "<p>What became of each: matched, refused, gone from the street, "
+          "not recognised, or not reconstructed and why.</p>\n"
+       << ArrayTable(report.value("crossings_in_view", json::array()));
   html << "<p>Observations not matched, by reason:</p>\n"
        << ArrayTable(report["unmatched_reasons"]);
   html << "<h2>Database faults found</h2>\n"
+       << "<p>Each with the evidence it rests on: a crossing or band is gone "
+          "from the street only where the images show bare road at its "
+          "place.</p>\n"
        << ArrayTable(report["database_faults"]);
+  html << "<h2>Not recognised (not faults)</h2>\n"
+       << "<p>Database crossings and bands in view that were not recognised "
+          "while the images do not show them gone: paint seen at their "
+          "place, or occluded or not told.</p>\n"
+       << ArrayTable(report.value("not_recognised", json::array()));
   html << "<h2>Stretches without control</h2>\n"
        << ArrayTable(report["uncontrolled_stretches"]);
+  html << "<h2>Stretches where one axis is held by no control</h2>\n"
+       << "<p>The axis' posterior sd above the threshold (the database's "
+          "accuracy): road lines hold cross-track and height, never "
+          "along-track.</p>\n"
+       << ArrayTable(report.value("weakly_held_stretches", json::array()));
   html << "<h2>Road lines</h2>\n"
        << RoadLineSection(report.value("road_lines", json()), data);
   html << "<h2>Counts</h2>\n" << KeyValueTable(report["counts"]);

@@ -277,8 +277,17 @@ std::vector<std::string> ReportWarnings(const ReportInputs& inputs,
   }
   for (const json& fault : (*report)["database_faults"]) {
     if (fault.contains("description")) {
-      warnings.push_back("database: " +
-                         fault["description"].get<std::string>());
+      warnings.push_back(
+          "database: " + fault["description"].get<std::string>() +
+          (fault.contains("evidence")
+               ? " (evidence: " + fault["evidence"].get<std::string>() + ")"
+               : std::string()));
+    }
+  }
+  // Whole crossings not recognised: the user should look, not delete.
+  for (const json& mark : (*report)["not_recognised"]) {
+    if (!mark.contains("band") && mark.contains("description")) {
+      warnings.push_back(mark["description"].get<std::string>());
     }
   }
   return warnings;
@@ -365,7 +374,37 @@ json BuildFromData(const ReportInputs& inputs, const ReportOptions& options,
       data.match_evidence.is_object() && data.match_evidence.contains("faults")
           ? data.match_evidence["faults"]
           : json::array();
+  // Every database crossing in view and what became of it (issue 51), as
+  // the first registration pass left it; crossing_decisions.csv holds the
+  // second pass' matches too.
+  report["crossings_in_view"] =
+      data.match_evidence.is_object()
+          ? data.match_evidence.value("crossings_in_view", json::array())
+          : json::array();
+  for (json& c : report["crossings_in_view"]) {
+    const std::string status = c.value("status", std::string());
+    if (status != "matched" &&
+        matched_crossings.count(c.value("crossing_id", std::string()))) {
+      c["reason"] =
+          "by the second pass, on the adjusted trajectory (the "
+          "first: " +
+          status + ")";
+      c["status"] = "matched";
+    }
+  }
+  // Database crossings and bands in view that were not recognised, with no
+  // image evidence that they are gone: apart from the faults (issue 52).
+  report["not_recognised"] =
+      data.match_evidence.is_object()
+          ? data.match_evidence.value("not_recognised", json::array())
+          : json::array();
   report["uncontrolled_stretches"] = UncontrolledStretches(data, options);
+  // Stretches where one axis is held by no control (the adjustment's
+  // posterior sd; its warnings say so too).
+  report["weakly_held_stretches"] =
+      data.adjustment.is_object()
+          ? data.adjustment.value("weakly_held_stretches", json::array())
+          : json::array();
   if (data.line_control.is_object()) report["road_lines"] = data.line_control;
 
   json timings = json::object();

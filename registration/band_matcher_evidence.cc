@@ -131,11 +131,12 @@ void AddMissingBands(const MatchState& state, const Obs& obs,
       if (!may_look) continue;
       // A band the reconstruction missed (hidden, worn, lost at range) is
       // no evidence; bare road where the hypothesis puts paint is.
-      if (input.paint_probe &&
-          input.paint_probe(obs.source->exposure_id, pose,
-                            index.bands()[b].corners_enu,
-                            seen) != PaintEvidence::kBareRoad) {
-        continue;
+      if (input.paint_probe) {
+        const PaintEvidence evidence = input.paint_probe(
+            obs.source->exposure_id, pose, index.bands()[b].corners_enu, seen);
+        if (evidence == PaintEvidence::kPaint) eval->painted.push_back(b);
+        if (evidence == PaintEvidence::kUnknown) eval->unclear.push_back(b);
+        if (evidence != PaintEvidence::kBareRoad) continue;
       }
       eval->missing.push_back(b);
     }

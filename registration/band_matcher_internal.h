@@ -129,6 +129,11 @@ struct Eval {
   // of a band the database may have lost at its far end.
   std::vector<int> beyond_first;
   std::vector<int> partial;  // observed bands
+  // Database bands predicted in view, not reconstructed, where the image
+  // probe saw paint, or could not tell (a vehicle, a shadow, out of view):
+  // no evidence against the hypothesis, and no database fault (issue 52).
+  std::vector<int> painted;
+  std::vector<int> unclear;
   double score = 0.0;
 
   // The crossing most hits fall on, or -1.
@@ -236,6 +241,8 @@ struct MatchState {
   std::vector<ObservationEvidence> evidence;
   std::vector<VertexMatch> matches;
   std::vector<DatabaseFault> faults;
+  std::vector<UnrecognisedMark> unrecognised;
+  std::vector<CrossingInView> crossings_in_view;
   std::vector<int> by_time;  // observation indices sorted by time
   // Per observation: [first, last) positions in by_time of its window.
   std::vector<std::pair<int, int>> window;

@@ -1,9 +1,8 @@
 // Step 5 of MatchBands (band_matcher_internal.h): each accepted
 // observation's correction refined on its own bands into vertex matches
 // (the bands whose corners lie on them across their axis, and the corners
-// that also lie at their ends, to vertex_tolerance_m), the database
-// faults the decisions reveal, and the result with a decision per
-// observation.
+// that also lie at their ends, to vertex_tolerance_m), and the result with
+// a decision per observation (the database faults: band_matcher_faults.cc).
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -91,219 +90,6 @@ std::vector<VertexMatch> RefinedMatches(const MatchState& state, int o,
   return out;
 }
 
-// Bands missing on either side (from the street, from the database), from
-// matched observations.
-void DetectBandFaults(MatchState* state) {
-  const MatchInput& input = state->input;
-  const MatchOptions& options = state->options;
-  const RoadmarkIndex& index = state->index;
-  const auto& crossings = index.crossings();
-  std::map<int, int> band_seen;                      // database band -> views
-  std::map<int, std::vector<int64_t>> band_missing;  // -> exposures
-  std::map<std::pair<int, int>, std::vector<int64_t>>
-      extra;  // (crossing, side)
-  std::set<int> matched_crossings;
-  for (size_t o = 0; o < state->obs.size(); ++o) {
-    if (!state->accepted[o]) continue;
-    const Hypothesis& h = state->hypotheses[o][state->chosen[o]];
-    const int64_t exposure = input.observations[o].exposure_id;
-    for (const Hit& hit : h.eval.hits) {
-      ++band_seen[hit.db];
-      matched_crossings.insert(index.bands()[hit.db].crossing);
-    }
-    for (int b : h.eval.missing) {
-      if (!index.bands()[b].implied) band_missing[b].push_back(exposure);
-    }
-    if (h.main_crossing < 0) continue;
-    const IndexedCrossing& crossing = crossings[h.main_crossing];
-    const Eigen::Vector2d first = crossing.ToCrossing(crossing.first_end_enu);
-    const Eigen::Vector2d last = crossing.ToCrossing(crossing.last_end_enu);
-    for (int rec : h.eval.unexplained) {
-      const Eigen::Vector2d p =
-          crossing.ToCrossing(Apply(h.correction, state->obs[o].vehicle,
-                                    state->obs[o].bands[rec].shape.centre));
-      const double s = crossing.spacing_m;
-      if (std::abs(p.y() - (last.y() + s)) < 0.3 * s &&
-          std::abs(p.x() - last.x()) < crossing.band_length_m) {
-        extra[{h.main_crossing, +1}].push_back(exposure);
-      } else if (std::abs(p.y() - (first.y() - s)) < 0.3 * s &&
-                 std::abs(p.x() - first.x()) < crossing.band_length_m) {
-        extra[{h.main_crossing, -1}].push_back(exposure);
-      }
-    }
-  }
-  for (const auto& [b, exposures] : band_missing) {
-    if (static_cast<int>(exposures.size()) < options.min_views_for_fault ||
-        band_seen.count(b)) {
-      continue;
-    }
-    const IndexedBand& band = index.bands()[b];
-    DatabaseFault fault;
-    fault.kind = FaultKind::kBandMissingFromStreet;
-    fault.crossing_id = band.crossing_id;
-    fault.band = band.band;
-    fault.location_enu = band.centre_enu;
-    fault.views = static_cast<int>(exposures.size());
-    fault.exposure_ids = exposures;
-    fault.description = "database band " + std::to_string(band.band) +
-                        " of crossing " + band.crossing_id +
-                        " was not seen in " + std::to_string(fault.views) +
-                        " matched views that should have shown it: missing "
-                        "from the street (or occluded)";
-    state->faults.push_back(fault);
-  }
-  for (const auto& [key, exposures] : extra) {
-    if (static_cast<int>(exposures.size()) < options.min_views_for_fault) {
-      continue;
-    }
-    const IndexedCrossing& crossing = crossings[key.first];
-    DatabaseFault fault;
-    fault.kind = FaultKind::kBandMissingFromDatabase;
-    fault.crossing_id = crossing.crossing_id;
-    fault.band =
-        key.second > 0 ? crossing.last_band + 1 : crossing.first_band - 1;
-    fault.location_enu =
-        key.second > 0
-            ? Eigen::Vector2d(crossing.last_end_enu +
-                              crossing.spacing_m * crossing.across_axis)
-            : Eigen::Vector2d(crossing.first_end_enu -
-                              crossing.spacing_m * crossing.across_axis);
-    fault.views = static_cast<int>(exposures.size());
-    fault.exposure_ids = exposures;
-    fault.description = "a band was seen in " + std::to_string(fault.views) +
-                        " views beyond band " +
-                        std::to_string(key.second > 0 ? crossing.last_band
-                                                      : crossing.first_band) +
-                        " of crossing " + crossing.crossing_id +
-                        ": missing from the database";
-    state->faults.push_back(fault);
-  }
-}
-
-// Crossings missing from the database: groups of usable bands nothing
-// fits, clustered by place.
-void DetectCrossingsMissingFromDatabase(MatchState* state) {
-  const MatchInput& input = state->input;
-  const MatchOptions& options = state->options;
-  struct Cluster {
-    Eigen::Vector2d centre;
-    std::vector<int64_t> exposures;
-  };
-  std::vector<Cluster> clusters;
-  for (size_t o = 0; o < state->obs.size(); ++o) {
-    if (state->evidence[o].decision != Decision::kNoCandidate ||
-        state->obs[o].usable < 2) {
-      continue;
-    }
-    const Eigen::Vector2d p = state->obs[o].vehicle + state->obs[o].centroid_q;
-    Cluster* home = nullptr;
-    for (Cluster& cluster : clusters) {
-      if ((cluster.centre - p).norm() < 10.0) home = &cluster;
-    }
-    if (home == nullptr) {
-      clusters.push_back({p, {}});
-      home = &clusters.back();
-    }
-    home->exposures.push_back(input.observations[o].exposure_id);
-  }
-  for (const Cluster& cluster : clusters) {
-    if (static_cast<int>(cluster.exposures.size()) <
-        options.min_views_for_fault) {
-      continue;
-    }
-    DatabaseFault fault;
-    fault.kind = FaultKind::kCrossingMissingFromDatabase;
-    fault.location_enu = cluster.centre;
-    fault.views = static_cast<int>(cluster.exposures.size());
-    fault.exposure_ids = cluster.exposures;
-    fault.description =
-        "a crossing seen in " + std::to_string(fault.views) + " views near E " +
-        FormatFixed(cluster.centre.x(), 1) + " N " +
-        FormatFixed(cluster.centre.y(), 1) +
-        " (measured trajectory) has no database crossing within the drift "
-        "gate: missing from the database";
-    state->faults.push_back(fault);
-  }
-}
-
-// Crossings gone from the street: fully in view of several exposures (with
-// the correction of the nearest match) and never fitted by anything seen.
-void DetectCrossingsGoneFromStreet(MatchState* state) {
-  const MatchInput& input = state->input;
-  const MatchOptions& options = state->options;
-  const RoadmarkIndex& index = state->index;
-  const Visibility& visibility = state->visibility;
-  const auto& crossings = index.crossings();
-  if (!visibility.enabled()) return;
-  std::set<int> touched;  // crossings some hypothesis explains bands of
-  for (const std::vector<Hypothesis>& list : state->hypotheses) {
-    for (const Hypothesis& h : list) {
-      for (const Hit& hit : h.eval.hits) {
-        touched.insert(index.bands()[hit.db].crossing);
-      }
-    }
-  }
-  std::vector<std::pair<double, PoseCorrection>> known;
-  for (int o : state->by_time) {
-    if (state->accepted[o]) {
-      known.emplace_back(input.observations[o].time_s,
-                         state->hypotheses[o][state->chosen[o]].correction);
-    }
-  }
-  std::map<int, std::vector<int64_t>> should_have_seen;
-  std::vector<int> near;
-  for (const ExposurePose& exposure : input.exposures) {
-    PoseCorrection c;
-    if (!known.empty()) {
-      const auto it =
-          std::lower_bound(known.begin(), known.end(), exposure.time_s,
-                           [](const std::pair<double, PoseCorrection>& k,
-                              double t) { return k.first < t; });
-      const auto& nearest =
-          it == known.end()
-              ? known.back()
-              : (it == known.begin() ||
-                         it->first - exposure.time_s <
-                             exposure.time_s - std::prev(it)->first
-                     ? *it
-                     : *std::prev(it));
-      c = nearest.second;
-    }
-    const Pose pose = CorrectedPose(exposure.pose, c);
-    index.CrossingsWithin(pose.p_enu.head<2>(), visibility.range_m(), &near);
-    for (int crossing : near) {
-      if (touched.count(crossing)) continue;
-      const IndexedCrossing& x = crossings[crossing];
-      int visible = 0;
-      for (int b : x.bands) {
-        visible += visibility.BandVisible(pose, index.bands()[b]) ? 1 : 0;
-      }
-      if (visible >= std::min<int>(3, static_cast<int>(x.bands.size()))) {
-        should_have_seen[crossing].push_back(exposure.exposure_id);
-      }
-    }
-  }
-  for (const auto& [crossing, exposures] : should_have_seen) {
-    if (static_cast<int>(exposures.size()) < options.min_views_for_fault) {
-      continue;
-    }
-    const IndexedCrossing& x = crossings[crossing];
-    DatabaseFault fault;
-    fault.kind = FaultKind::kCrossingGoneFromStreet;
-    fault.crossing_id = x.crossing_id;
-    fault.location_enu = x.centre_enu;
-    fault.views = static_cast<int>(exposures.size());
-    fault.exposure_ids = exposures;
-    fault.description = "database crossing " + x.crossing_id +
-                        " was in full "
-                        "view of " +
-                        std::to_string(fault.views) +
-                        " exposures and nothing seen fits it: gone from the "
-                        "street";
-    state->faults.push_back(fault);
-  }
-}
-
 }  // namespace
 
 bool RefuseUnrefined(int o, MatchState* state) {
@@ -330,12 +116,6 @@ void EmitMatches(int o, MatchState* state) {
       *state, o, &ev.correction, &ev.matched_bands, &ev.vertex_rms_m);
   ev.vertex_matches = static_cast<int>(out.size());
   state->matches.insert(state->matches.end(), out.begin(), out.end());
-}
-
-void DetectFaults(MatchState* state) {
-  DetectBandFaults(state);
-  DetectCrossingsMissingFromDatabase(state);
-  DetectCrossingsGoneFromStreet(state);
 }
 
 void Finish(MatchState* state, MatchResult* result) {
@@ -408,6 +188,8 @@ void Finish(MatchState* state, MatchResult* result) {
   result->matches = std::move(state->matches);
   result->evidence = std::move(state->evidence);
   result->faults = std::move(state->faults);
+  result->unrecognised = std::move(state->unrecognised);
+  result->crossings_in_view = std::move(state->crossings_in_view);
 }
 
 }  // namespace band_matcher_internal

@@ -69,6 +69,8 @@ std::string PaintProbeOptions::Check() const {
   OPTION_GT(check, max_bare_spread, 0.0);
   OPTION_IN(check, min_inside_share, "(", 0.0, 1.0, "]");
   OPTION_GE(check, cached_images, 1);
+  OPTION_GT(check, assumed_paint_contrast, 0.0);
+  OPTION_GT(check, max_road_level_change, 0.0);
   return check.problem();
 }
 
@@ -149,11 +151,17 @@ bool ImagePaintProbe::Sample(const cv::Mat& image,
 PaintEvidence ImagePaintProbe::Classify(
     int64_t exposure_id, const Pose& pose, const BandCornersEnu& band,
     const std::vector<BandCornersEnu>& seen) {
-  if (camera_ < 0 || seen.empty()) return PaintEvidence::kUnknown;
+  if (camera_ < 0) return PaintEvidence::kUnknown;
   const cv::Mat* image = LeftImage(exposure_id);
   if (image == nullptr) return PaintEvidence::kUnknown;
   const Eigen::Isometry3d T_cam_enu =
       (pose.T_enu_body() * survey_.rig.cameras[camera_].T_body_cam).inverse();
+  if (seen.empty()) {
+    const double road = RoadAheadLevel(*image, T_cam_enu, band);
+    if (!(road > 1.0)) return PaintEvidence::kUnknown;
+    return Verdict(*image, T_cam_enu, band, options_.assumed_paint_contrast,
+                   road, exposure_id);
+  }
   // Paint: the seen bands. Asphalt: the gaps between neighbouring ones.
   std::vector<float> paint, asphalt, values;
   for (size_t i = 0; i < seen.size(); ++i) {
@@ -177,8 +185,41 @@ PaintEvidence ImagePaintProbe::Classify(
   if (!(road_level > 1.0) || paint_level - road_level < options_.min_contrast) {
     return PaintEvidence::kUnknown;
   }
-  const double contrast = paint_level / road_level - 1.0;
-  if (!Sample(*image, T_cam_enu, band, &values)) {
+  return Verdict(*image, T_cam_enu, band, paint_level / road_level - 1.0, 0.0,
+                 exposure_id);
+}
+
+double ImagePaintProbe::RoadAheadLevel(const cv::Mat& image,
+                                       const Eigen::Isometry3d& T_cam_enu,
+                                       const BandCornersEnu& band) const {
+  // Ahead: the camera's optical axis, level.
+  const Eigen::Isometry3d T_enu_cam = T_cam_enu.inverse();
+  Eigen::Vector3d ahead = T_enu_cam.linear().col(2);
+  ahead.z() = 0.0;
+  if (ahead.norm() < 1e-6) return 0.0;
+  ahead.normalize();
+  const Eigen::Vector3d left(-ahead.y(), ahead.x(), 0.0);
+  Eigen::Vector3d base = T_enu_cam.translation();
+  base.z() = Centre(band).z();
+  // A quad 3 m long and 1 m wide in the vehicle's own lane, 5 to 8 m
+  // ahead (sampled in its middle, sample_share).
+  const BandCornersEnu patch = {
+      base + 5.0 * ahead - 0.5 * left, base + 5.0 * ahead + 0.5 * left,
+      base + 8.0 * ahead + 0.5 * left, base + 8.0 * ahead - 0.5 * left};
+  std::vector<float> values;
+  if (!Sample(image, T_cam_enu, patch, &values)) return 0.0;
+  double level, spread;
+  Quartiles(&values, &level, &spread);
+  return level;
+}
+
+PaintEvidence ImagePaintProbe::Verdict(const cv::Mat& image,
+                                       const Eigen::Isometry3d& T_cam_enu,
+                                       const BandCornersEnu& band,
+                                       double contrast, double road_ahead_level,
+                                       int64_t exposure_id) const {
+  std::vector<float> values;
+  if (!Sample(image, T_cam_enu, band, &values)) {
     return PaintEvidence::kUnknown;
   }
   double level, spread;
@@ -189,7 +230,7 @@ PaintEvidence ImagePaintProbe::Classify(
   for (double sign : {-1.0, 1.0}) {
     BandCornersEnu side = band;
     for (Eigen::Vector3d& corner : side) corner += sign * 0.5 * across;
-    if (Sample(*image, T_cam_enu, side, &values)) {
+    if (Sample(image, T_cam_enu, side, &values)) {
       beside.insert(beside.end(), values.begin(), values.end());
     }
   }
@@ -198,11 +239,22 @@ PaintEvidence ImagePaintProbe::Classify(
   Quartiles(&beside, &local_level, &local_spread);
   if (!(local_level > 1.0)) return PaintEvidence::kUnknown;
   const double share = (level / local_level - 1.0) / contrast;
-  VLOG(2) << "paint probe: exposure " << exposure_id << " paint " << paint_level
-          << " asphalt " << road_level << " band " << level << " (" << spread
-          << ") beside " << local_level << " (" << local_spread << "): share "
-          << share;
-  if (share >= options_.paint_level) return PaintEvidence::kPaint;
+  VLOG(2) << "paint probe: exposure " << exposure_id << " contrast " << contrast
+          << " band " << level << " (" << spread << ") beside " << local_level
+          << " (" << local_spread << ") road ahead " << road_ahead_level
+          << ": share " << share;
+  if (share >= options_.paint_level) {
+    // Without measured paint, bright is paint only where it is as even as
+    // paint (not the kerb, a vehicle, a sunlit edge).
+    const bool even =
+        road_ahead_level <= 0.0 || spread <= options_.max_bare_spread * level;
+    return even ? PaintEvidence::kPaint : PaintEvidence::kUnknown;
+  }
+  // Without measured paint: bare only where the surface is the road's.
+  if (road_ahead_level > 0.0 && std::abs(local_level / road_ahead_level - 1.0) >
+                                    options_.max_road_level_change) {
+    return PaintEvidence::kUnknown;
+  }
   if (std::abs(share) <= options_.bare_level &&
       spread <= local_spread + options_.max_bare_spread * contrast * level) {
     return PaintEvidence::kBareRoad;

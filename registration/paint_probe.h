@@ -59,6 +59,14 @@ struct PaintProbeOptions {
   double max_bare_spread = 0.35;
   // Share of the samples that must fall inside the image.
   double min_inside_share = 0.8;
+  // Without seen bands (a database crossing nothing was matched to: is it
+  // gone from the street?) the paint contrast is not measured but assumed
+  // at least this (paint / asphalt - 1; road paint is 2-4 times as bright
+  // as asphalt), and the surface beside the band must look like the road
+  // right ahead of the vehicle (level within this share of it): a vehicle
+  // or a shadow over the crossing is not bare road.
+  double assumed_paint_contrast = 0.5;
+  double max_road_level_change = 0.25;
   // Decoded images kept in memory.
   int cached_images = 16;
 
@@ -71,6 +79,8 @@ struct PaintProbeOptions {
     v("bare_level", bare_level);
     v("max_bare_spread", max_bare_spread);
     v("min_inside_share", min_inside_share);
+    v("assumed_paint_contrast", assumed_paint_contrast);
+    v("max_road_level_change", max_road_level_change);
     v("cached_images", cached_images);
   }
 };
@@ -84,7 +94,10 @@ class ImagePaintProbe {
   // What the left image of the first stereo pair of `exposure_id` shows
   // inside `band`, seen from the body pose `pose`, given `seen` (database
   // bands matched in that image: their paint, and the asphalt between
-  // neighbours). Never throws: an unreadable image is kUnknown.
+  // neighbours). Never throws: an unreadable image is kUnknown. With no
+  // `seen` band the paint contrast is assumed (assumed_paint_contrast) and
+  // kBareRoad needs the surface beside the band to look like the road
+  // ahead of the vehicle (max_road_level_change).
   PaintEvidence Classify(int64_t exposure_id, const Pose& pose,
                          const BandCornersEnu& band,
                          const std::vector<BandCornersEnu>& seen);
@@ -98,6 +111,17 @@ class ImagePaintProbe {
   bool Sample(const cv::Mat& image, const Eigen::Isometry3d& T_cam_enu,
               const BandCornersEnu& quad, std::vector<float>* values) const;
   const cv::Mat* LeftImage(int64_t exposure_id);
+  // The verdict on `band` given the paint contrast (paint / asphalt - 1)
+  // and, when positive, the road's level ahead of the vehicle.
+  PaintEvidence Verdict(const cv::Mat& image,
+                        const Eigen::Isometry3d& T_cam_enu,
+                        const BandCornersEnu& band, double contrast,
+                        double road_ahead_level, int64_t exposure_id) const;
+  // The median grey level of the road 5-8 m ahead of the camera at the
+  // height of `band`, or 0 when not in view.
+  double RoadAheadLevel(const cv::Mat& image,
+                        const Eigen::Isometry3d& T_cam_enu,
+                        const BandCornersEnu& band) const;
 
   const Survey& survey_;
   PaintProbeOptions options_;

@@ -253,6 +253,14 @@ AdjustmentRecord RecordOf(const Fields& f) {
   r.road_lines_only = f.GetOr<bool>("road_lines_only", false);
   r.median_posterior_sd_horizontal_m = sd.Number("median_horizontal");
   r.median_posterior_sd_vertical_m = sd.Number("median_vertical");
+  for (const json& value : f.GetOr<json>("weakly_held_stretches", json())) {
+    const Fields w(value, f.name());
+    r.weakly_held.push_back({w.Get<std::string>("axis"),
+                             w.Number("begin_time_s"), w.Number("end_time_s"),
+                             w.Number("length_m"), w.Number("threshold_m"),
+                             w.Number("max_sd_m"), w.Number("median_sd_m"),
+                             w.Get<bool>("held_by_no_control")});
+  }
   for (const json& value : f.At("rejected")) {
     const Fields p(value, f.name());
     r.rejected.push_back({p.Get<std::string>("crossing_id"), p.Get<int>("band"),
@@ -320,6 +328,18 @@ json AdjustmentJson(const AdjustmentRecord& r) {
       {"computed", r.posterior_sd_computed},
       {"median_horizontal", r.median_posterior_sd_horizontal_m},
       {"median_vertical", r.median_posterior_sd_vertical_m}};
+  json weak = json::array();
+  for (const AdjustmentRecord::WeakStretch& w : r.weakly_held) {
+    weak.push_back({{"axis", w.axis},
+                    {"begin_time_s", w.begin_time_s},
+                    {"end_time_s", w.end_time_s},
+                    {"length_m", w.length_m},
+                    {"threshold_m", w.threshold_m},
+                    {"max_sd_m", w.max_sd_m},
+                    {"median_sd_m", w.median_sd_m},
+                    {"held_by_no_control", w.held_by_no_control}});
+  }
+  j["weakly_held_stretches"] = weak;
   json rejected = json::array();
   for (const AdjustmentRecord::Rejected& p : r.rejected) {
     rejected.push_back({{"crossing_id", p.crossing_id},

@@ -74,6 +74,21 @@ struct AdjustmentRecord {
   bool posterior_sd_computed = false;
   double median_posterior_sd_horizontal_m = 0.0;
   double median_posterior_sd_vertical_m = 0.0;
+  // Stretches where one axis of the position (axis "along_track",
+  // "cross_track" or "up") is held by no control: its posterior sd above
+  // threshold_m, or no control holding it near, over length_m of
+  // trajectory (issue 51). Absent from older files.
+  struct WeakStretch {
+    std::string axis;
+    double begin_time_s = 0.0;
+    double end_time_s = 0.0;
+    double length_m = 0.0;
+    double threshold_m = 0.0;
+    double max_sd_m = 0.0;  // NaN (null) without the posterior covariance
+    double median_sd_m = 0.0;
+    bool held_by_no_control = false;  // else the sd alone says it is weak
+  };
+  std::vector<WeakStretch> weakly_held;
   // Control vertices the blunder test removed.
   struct Rejected {
     std::string crossing_id;

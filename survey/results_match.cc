@@ -138,12 +138,38 @@ void WriteMatchEvidence(const MatchResult& result,
                   {"lon", g.lon_deg},
                   {"description", f.description}};
     if (f.band != 0) fault["band"] = f.band;
+    if (!f.evidence.empty()) fault["evidence"] = f.evidence;
     if (f.kind == FaultKind::kCrossingShifted) {
       fault["shift_m"] = Round(f.shift_m, 1e-3);
     }
     faults.push_back(std::move(fault));
   }
   root["faults"] = std::move(faults);
+  json unrecognised = json::array();
+  for (const UnrecognisedMark& m : result.unrecognised) {
+    const Geodetic g = frame.GeodeticFromEnu(
+        Eigen::Vector3d(m.location_enu.x(), m.location_enu.y(), 0.0));
+    json mark = {{"crossing_id", m.crossing_id},
+                 {"why", m.why},
+                 {"views", m.views},
+                 {"exposure_ids", m.exposure_ids},
+                 {"east", Round(m.location_enu.x(), 1e-3)},
+                 {"north", Round(m.location_enu.y(), 1e-3)},
+                 {"lat", g.lat_deg},
+                 {"lon", g.lon_deg},
+                 {"description", m.description}};
+    if (m.band != 0) mark["band"] = m.band;
+    unrecognised.push_back(std::move(mark));
+  }
+  root["not_recognised"] = std::move(unrecognised);
+  json in_view = json::array();
+  for (const CrossingInView& c : result.crossings_in_view) {
+    in_view.push_back({{"crossing_id", c.crossing_id},
+                       {"status", c.status},
+                       {"reason", c.reason},
+                       {"views", c.views}});
+  }
+  root["crossings_in_view"] = std::move(in_view);
   WriteFileAtomically(path,
                       [&](std::ostream& out) { out << root.dump(1) << "\n"; });
 }

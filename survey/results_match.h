@@ -63,6 +63,26 @@ struct DatabaseFault {
   int views = 0;         // exposures behind the finding
   std::vector<int64_t> exposure_ids;
   std::string description;
+  // What the finding rests on: for a crossing or band gone from the street,
+  // the images' bare road where the paint should be (issue 52: never a
+  // fault the images do not show).
+  std::string evidence;
+};
+
+// A database crossing or band the images should have shown that was not
+// recognised, without evidence that it is gone (paint seen at its place,
+// or the images could not tell: occluded, shadowed, out of view, no
+// images): not a database fault, listed apart.
+struct UnrecognisedMark {
+  std::string crossing_id;
+  int band = 0;  // 0: the whole crossing
+  Eigen::Vector2d location_enu = Eigen::Vector2d::Zero();
+  // "paint seen" (painted, not reconstructed or not matched), "occluded or
+  // not told" (neither paint nor bare road in the images), "no images".
+  std::string why;
+  int views = 0;
+  std::vector<int64_t> exposure_ids;
+  std::string description;
 };
 
 // Why one observation was decided as it was.
@@ -116,11 +136,23 @@ struct MatchSummary {
   std::string BriefReport() const;
 };
 
+// What became of one database crossing in view (issue 51): "matched",
+// "refused", "not matched", "gone from the street", "not recognised" or
+// "not reconstructed", and why.
+struct CrossingInView {
+  std::string crossing_id;
+  std::string status;
+  std::string reason;
+  int views = 0;  // exposures with at least one of its bands in full view
+};
+
 struct MatchResult {
   std::vector<VertexMatch> matches;
   std::vector<CrossingDecision> decisions;    // one per observation, in order
   std::vector<ObservationEvidence> evidence;  // one per observation, in order
   std::vector<DatabaseFault> faults;
+  std::vector<UnrecognisedMark> unrecognised;
+  std::vector<CrossingInView> crossings_in_view;
   MatchSummary summary;
 };
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <random>
 
 #include "campaign/merge.h"
@@ -99,6 +100,76 @@ TEST(BlockWeight, TheTwoBlocksOfAnOverlapSumToOneAndAreContinuous) {
   }
   EXPECT_EQ(BlockWeight(61.0, 0.0, 60.0, nullptr, &overlap_start), 0.0);
   EXPECT_EQ(BlockWeight(50.0, 0.0, 60.0, nullptr, &overlap_start), 0.5);
+}
+
+// Three blocks over samples 0..100 (1 s apart), each a constant offset of
+// the truth: outside the overlaps a sample is its block's, inside it lies
+// between the two blocks' (lerp and slerp with BlockWeight), and the blend
+// steps by no more than the weight's slope allows.
+TEST(BlendBlockPoses, EachBlockWholeOutsideOverlapsAndContinuousAcross) {
+  std::vector<double> times;
+  for (int i = 0; i <= 100; ++i) times.push_back(i);
+  std::vector<CampaignBlock> blocks(3);
+  const int ranges[3][2] = {{0, 40}, {30, 70}, {60, 100}};
+  for (int k = 0; k < 3; ++k) {
+    blocks[k].index = k;
+    blocks[k].first_sample = ranges[k][0];
+    blocks[k].last_sample = ranges[k][1];
+    blocks[k].start_time = times[ranges[k][0]];
+    blocks[k].end_time = times[ranges[k][1]];
+  }
+  // Overlaps [30, 40] and [60, 70].
+  const double start01 = 30.0, end01 = 40.0, start12 = 60.0, end12 = 70.0;
+  const Eigen::Vector3d offset[3] = {Eigen::Vector3d(0.0, 0.0, 0.0),
+                                     Eigen::Vector3d(0.04, 0.0, 0.01),
+                                     Eigen::Vector3d(0.0, -0.03, 0.0)};
+  const double yaw[3] = {0.0, 0.002, -0.001};
+  std::vector<std::vector<Pose>> poses(3);
+  for (int k = 0; k < 3; ++k) {
+    for (int i = ranges[k][0]; i <= ranges[k][1]; ++i) {
+      Pose p;
+      p.p_enu = Eigen::Vector3d(10.0 * i, 0.0, 0.0) + offset[k];
+      p.q_enu_body = Eigen::Quaterniond(
+          Eigen::AngleAxisd(yaw[k], Eigen::Vector3d::UnitZ()));
+      poses[k].push_back(p);
+    }
+  }
+  std::vector<BlockPoses> views = {{&blocks[0], nullptr, &start01, &poses[0]},
+                                   {&blocks[1], &end01, &start12, &poses[1]},
+                                   {&blocks[2], &end12, nullptr, &poses[2]}};
+  std::vector<int> dominant;
+  const std::vector<Pose> merged = BlendBlockPoses(times, views, &dominant);
+  ASSERT_EQ(merged.size(), times.size());
+  for (int i = 0; i <= 100; ++i) {
+    const Eigen::Vector3d shift =
+        merged[i].p_enu - Eigen::Vector3d(10.0 * i, 0.0, 0.0);
+    const int own = i < 30 ? 0 : (i > 40 && i < 60) ? 1 : i > 70 ? 2 : -1;
+    if (own >= 0) {
+      EXPECT_LT((shift - offset[own]).norm(), 1e-9) << i;
+      EXPECT_EQ(dominant[i], own) << i;
+      continue;
+    }
+    // Inside an overlap: on the segment between the two blocks' offsets.
+    const int a = i <= 40 ? 0 : 1;
+    const Eigen::Vector3d d = offset[a + 1] - offset[a];
+    const double u = (shift - offset[a]).dot(d) / d.squaredNorm();
+    EXPECT_GE(u, -1e-9) << i;
+    EXPECT_LE(u, 1.0 + 1e-9) << i;
+    EXPECT_LT((shift - offset[a] - u * d).norm(), 1e-9) << i;
+    const double angle =
+        Eigen::AngleAxisd(merged[i].q_enu_body).angle() *
+        (Eigen::AngleAxisd(merged[i].q_enu_body).axis().z() < 0 ? -1 : 1);
+    EXPECT_NEAR(angle, yaw[a] + u * (yaw[a + 1] - yaw[a]), 1e-9) << i;
+    // Smoothstep over 10 s: at most 1.5/10 of the difference per second.
+    const Eigen::Vector3d before =
+        merged[i - 1].p_enu - Eigen::Vector3d(10.0 * (i - 1), 0.0, 0.0);
+    EXPECT_LE((shift - before).norm(), 0.15 * d.norm() + 1e-9) << i;
+  }
+  // A sample no block holds.
+  blocks[1].first_sample = 45;
+  blocks[1].start_time = 45.0;
+  poses[1].erase(poses[1].begin(), poses[1].begin() + 15);
+  EXPECT_THROW(BlendBlockPoses(times, views, &dominant), std::exception);
 }
 
 }  // namespace

@@ -2,16 +2,21 @@
 // lines alone correct, on which the second registration pass searches when the
 // adjustment had too few crossings. A synthetic survey drifting by a metre,
 // two lane lines painted along its true path and drawn so in the database,
-// their points reconstructed ideally from the true poses.
+// their points reconstructed ideally from the true poses. And the report
+// of a survey whose last stretch only road lines control (issue 51).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "pipeline/adjust_outputs.h"
 #include "pipeline/adjustment_pass.h"
+#include "pipeline/report_stage.h"
 #include "tests/support/synthetic_survey.h"
+#include "tests/survey/test_util.h"
 
 namespace zebrageo {
 namespace {
@@ -165,6 +170,93 @@ TEST_F(RoadLinesAdjustmentTest, NothingWithoutLinePointsOrWhenTurnedOff) {
   data_.roadmarks.lines.clear();
   EXPECT_FALSE(AdjustByRoadLinesAlone(data_, &points_, AdjustmentOptions(), {})
                    .has_value());
+}
+
+// Crossings control the first 130 m of a 300 m survey, road lines alone
+// the rest: they hold it across and in height, never along. The
+// adjustment's posterior sd says so, and report.json names the stretch.
+TEST(WeaklyHeldStretches, ReportNamesTheStretchWithoutAlongTrackControl) {
+  SyntheticSurveyOptions options;
+  options.num_exposures = 100;  // 300 m, crossings at 40, 120, 200, 280 m
+  options.drift_horizontal_m = 1.0;
+  options.drift_period_s = 30.0;
+  const SyntheticSurvey survey = MakeSyntheticSurvey(options);
+  std::vector<std::string> crossings;
+  for (const RoadmarkBand& band : survey.database.bands) {
+    if (crossings.empty() || crossings.back() != band.crossing_id) {
+      crossings.push_back(band.crossing_id);
+    }
+  }
+  ASSERT_GE(crossings.size(), 4u);
+  const std::set<std::string> control = {crossings[0], crossings[1]};
+  AdjustmentData data;
+  data.rig = survey.rig;
+  data.frame = survey.frame;
+  data.trajectory = Trajectory(survey.measured_samples, survey.frame);
+  data.exposures = survey.exposures;
+  data.roadmarks = survey.database;
+  data.roadmarks.lines = DatabaseLines(survey);
+  data.vertices = survey.vertices;
+  for (const VertexMatch& m : survey.matches) {
+    if (control.count(m.crossing_id)) data.matches.push_back(m);
+  }
+  const std::vector<ReconstructedLinePoint> points = IdealLinePoints(survey);
+  const AdjustmentOptions adjustment;
+  const AdjustmentPass pass = AdjustWithRoadLines(
+      data, data.Input(), adjustment, LineRegistrationOptions(), &points);
+  ASSERT_TRUE(pass.result.summary.IsUsable()) << pass.result.summary.message;
+  ASSERT_TRUE(pass.lines.has_value());
+  const AdjustmentRecord record =
+      AdjustmentRecordOf(data, adjustment, pass.result, nullptr);
+  ASSERT_TRUE(record.posterior_sd_computed);
+
+  TemporaryFolder folder;
+  WriteSyntheticSurvey(survey, folder.Path("survey"), folder.Path("results"));
+  WriteAdjustmentRecord(record, folder.Path("results/adjustment.json"));
+  SurveyLoadOptions load_options;
+  load_options.require_images = false;
+  const Survey loaded = LoadSurvey(folder.Path("survey"), load_options);
+  ReportInputs inputs;
+  inputs.survey = &loaded;
+  inputs.results_folder = folder.Path("results");
+  const nlohmann::json report = BuildReport(inputs, ReportOptions());
+
+  // The last control crossing lies 120 m in (t0 + 12 s); its bands are
+  // seen up to 16 m ahead. From about 30 m past it to the end, along-track
+  // is free.
+  const double t0 = survey.measured_samples.front().time;
+  const double t_end = survey.measured_samples.back().time;
+  bool along_named = false;
+  for (const nlohmann::json& s : report.at("weakly_held_stretches")) {
+    const double begin = s.at("begin_time_s").get<double>();
+    const double end = s.at("end_time_s").get<double>();
+    const std::string axis = s.at("axis").get<std::string>();
+    if (axis == "along_track" && end > t_end - 1.0) {
+      along_named = true;
+      EXPECT_GT(begin, t0 + 12.0);
+      EXPECT_LT(begin, t0 + 17.0);
+      EXPECT_GT(s.at("length_m").get<double>(), 130.0);
+      EXPECT_TRUE(s.at("held_by_no_control").get<bool>());
+      // With the adjustment's posterior sd there.
+      EXPECT_GT(s.at("max_sd_m").get<double>(), 0.0);
+      EXPECT_GE(s.at("max_sd_m").get<double>(),
+                s.at("median_sd_m").get<double>());
+    }
+    // Road lines hold cross-track and height to the end.
+    if (axis != "along_track") {
+      EXPECT_LT(end, t0 + 25.0) << s.dump();
+    }
+    // The crossings hold every axis where they are.
+    EXPECT_GT(begin, t0 + 10.0) << s.dump();
+  }
+  EXPECT_TRUE(along_named) << report.at("weakly_held_stretches").dump();
+  bool warned = false;
+  for (const nlohmann::json& w : report.at("warnings")) {
+    warned = warned || w.get<std::string>().find(
+                           "along-track position is held by no "
+                           "control") != std::string::npos;
+  }
+  EXPECT_TRUE(warned) << report.at("warnings").dump();
 }
 
 }  // namespace

@@ -57,6 +57,14 @@ bool HasFault(const MatchResult& result, FaultKind kind,
   return false;
 }
 
+const UnrecognisedMark* Unrecognised(const MatchResult& result,
+                                     const std::string& crossing_id, int band) {
+  for (const UnrecognisedMark& mark : result.unrecognised) {
+    if (mark.crossing_id == crossing_id && mark.band == band) return &mark;
+  }
+  return nullptr;
+}
+
 double MatchedShare(const MatchScore& score) {
   return score.crossings_eligible.empty()
              ? 1.0
@@ -352,19 +360,6 @@ TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
   EXPECT_TRUE(Contains(run.score.crossings_matched, "C04"));
 }
 
-TEST(BandMatcher, ReportsCrossingGoneFromTheStreet) {
-  SyntheticSceneOptions options = Street(9, 5);
-  options.crossings[2].in_street = false;
-  const SceneRun run = MatchScene(options);
-  SCOPED_TRACE(run.result.summary.BriefReport());
-  EXPECT_EQ(run.score.wrong, 0);
-  EXPECT_TRUE(HasFault(run.result, FaultKind::kCrossingGoneFromStreet, "C03"));
-  for (const std::string id : {"C01", "C02", "C04", "C05"}) {
-    EXPECT_FALSE(HasFault(run.result, FaultKind::kCrossingGoneFromStreet, id))
-        << id;
-  }
-}
-
 TEST(BandMatcher, ReportsCrossingMissingFromTheDatabase) {
   SyntheticSceneOptions options = Street(10, 5);
   options.crossings[1].in_database = false;
@@ -394,8 +389,11 @@ TEST(BandMatcher, ReportsBandsMissingOnEitherSideWithoutGuessing) {
   const SceneRun run = MatchScene(options, smooth);
   SCOPED_TRACE(run.result.summary.BriefReport());
   EXPECT_EQ(run.score.wrong, 0);
-  EXPECT_TRUE(
+  // Without images: not recognised, not missing from the street.
+  EXPECT_FALSE(
       HasFault(run.result, FaultKind::kBandMissingFromStreet, "C02", 6));
+  ASSERT_NE(Unrecognised(run.result, "C02", 6), nullptr);
+  EXPECT_EQ(Unrecognised(run.result, "C02", 6)->why, "no images");
 }
 
 TEST(BandMatcher, ReportsARepaintedCrossingShiftedByDecimetres) {

@@ -57,7 +57,7 @@ class PaintProbeTest : public ::testing::Test {
 
   // Asphalt 40 (noise 2), bands painted at x0 = -2, -1, 0, 1 (grey 90), a
   // cast shadow (x 0.45) over x < -1.05, a textured occluder on x in
-  // [3, 3.5]; nothing at x0 = 2.
+  // [3, 3.5], an even one on x in [3.8, 5.8]; nothing at x0 = 2.
   void Render() {
     cv::Mat image(480, 640, CV_8U, cv::Scalar(0));
     std::mt19937 rng(3);
@@ -65,7 +65,7 @@ class PaintProbeTest : public ::testing::Test {
     std::uniform_int_distribution<int> texture(0, 255);
     const Eigen::Isometry3d T_cam_enu = CameraPose().inverse();
     const Camera& camera = survey_.rig.cameras[0].camera;
-    for (double x = -4.0; x <= 4.5; x += 0.004) {
+    for (double x = -4.0; x <= 6.0; x += 0.004) {
       for (double y = 5.0; y <= 14.0; y += 0.004) {
         double value = 40.0 + noise(rng);
         for (double x0 : {-2.0, -1.0, 0.0, 1.0}) {
@@ -75,6 +75,8 @@ class PaintProbeTest : public ::testing::Test {
         if (x >= 3.0 && x <= 3.5 && y >= 7.5 && y <= 11.5) {
           value = texture(rng);
         }
+        // An even, untextured vehicle side, brighter than the asphalt.
+        if (x >= 3.8 && x <= 5.8 && y >= 7.5 && y <= 11.5) value = 75.0;
         Eigen::Vector2d uv;
         if (!camera.Project(T_cam_enu * Eigen::Vector3d(x, y, 0.0), &uv)) {
           continue;
@@ -87,6 +89,12 @@ class PaintProbeTest : public ::testing::Test {
       }
     }
     ASSERT_TRUE(cv::imwrite((folder_ / "left.png").string(), image));
+  }
+
+  // Without seen bands: the paint contrast assumed.
+  PaintEvidence ClassifyAlone(const BandCornersEnu& band) {
+    ImagePaintProbe probe(survey_);
+    return probe.Classify(1, Pose(), band, {});
   }
 
   PaintEvidence Classify(const BandCornersEnu& band) {
@@ -121,6 +129,24 @@ TEST_F(PaintProbeTest, NoEvidenceOfAbsenceOutOfViewOrBehindAnOccluder) {
   // A textured occluder is not bare road (what it is does not matter: only
   // kBareRoad counts against a hypothesis).
   EXPECT_NE(Classify(BandAt(3.0)), PaintEvidence::kBareRoad);
+}
+
+// A database crossing nothing was matched to (gone from the street?):
+// no seen band to measure the paint contrast on.
+TEST_F(PaintProbeTest, WithoutSeenBandsPaintAndBareRoadAreStillTold) {
+  EXPECT_EQ(ClassifyAlone(BandAt(0.0)), PaintEvidence::kPaint);
+  EXPECT_EQ(ClassifyAlone(BandAt(1.0)), PaintEvidence::kPaint);
+  EXPECT_EQ(ClassifyAlone(BandAt(2.0)), PaintEvidence::kBareRoad);
+}
+
+TEST_F(PaintProbeTest, WithoutSeenBandsAnEvenVehicleSideIsNotBareRoad) {
+  // Even and the same beside the band: bare road by contrast alone; its
+  // level is not the road's ahead of the vehicle.
+  EXPECT_NE(ClassifyAlone(BandAt(4.5)), PaintEvidence::kBareRoad);
+  EXPECT_NE(ClassifyAlone(BandAt(3.0)), PaintEvidence::kBareRoad);
+  BandCornersEnu far = BandAt(2.0);
+  for (Eigen::Vector3d& corner : far) corner.y() += 100.0;
+  EXPECT_EQ(ClassifyAlone(far), PaintEvidence::kUnknown);
 }
 
 TEST_F(PaintProbeTest, MissingImageIsUnknownNotAnError) {
