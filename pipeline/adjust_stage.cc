@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <utility>
 
 #include "geodata/colmap_export.h"
@@ -14,6 +15,7 @@
 #include "pipeline/adjustment_pass.h"
 #include "pipeline/diagnosis.h"
 #include "pipeline/exit_codes.h"
+#include "pipeline/mount_attitude_check.h"
 #include "pipeline/rematch_stage.h"
 #include "survey/atomic_file.h"
 #include "survey/image_io.h"
@@ -201,6 +203,123 @@ bool Rematch(const Survey& survey, StageResults* results,
   return true;
 }
 
+// Steps "adjust" and "rematch" on the match stage's control. The last
+// adjustment logs its warnings when `log_warnings`.
+AdjustState AdjustAndRematch(const Survey& survey, StageResults* results,
+                             const TiePoints& ties, const RunOptions& options,
+                             bool log_warnings,
+                             const ProgressListener& progress,
+                             const CancellationToken& cancel,
+                             std::vector<std::string>* refusals) {
+  AdjustState state;
+  state.matches = results->Matches();
+  state.decisions = results->Decisions();
+  // With the second pass, an adjustment before it may not be the result:
+  // its warnings go to the report (and stderr) only if it is.
+  RunOptions trial = options;
+  trial.adjustment.log_warnings = false;
+  RunOptions last = options;
+  last.adjustment.log_warnings = log_warnings;
+  Adjust(survey, results, ties, options.rematch ? trial : last, progress,
+         cancel, &state);
+  for (int pass = 0; options.rematch && pass < kMaxRematchPasses; ++pass) {
+    cancel.ThrowIfCancelled();
+    if (!Rematch(survey, results, options, cancel, &state, refusals)) break;
+    const bool again = pass + 1 < kMaxRematchPasses;
+    Adjust(survey, results, ties, again ? trial : last, progress, cancel,
+           &state);
+  }
+  return state;
+}
+
+// The mount-like offset of the corrected body attitude against the input's
+// (mount_attitude_check.h).
+AttitudeOffset AttitudeOffsetOf(const Survey& survey,
+                                const MountAttitudeOptions& options,
+                                const AdjustState& state) {
+  return MountLikeAttitudeOffset(options, survey.trajectory.samples(),
+                                 survey.trajectory.poses(),
+                                 state.pass.result.corrected_poses);
+}
+
+// The boresight check's second look (mount_attitude_check.h): where the
+// adjustment turned the body by one rotation beyond the INS's sd, it is
+// repeated with the rig's boresight calibrated, and where that still
+// turns it, with the input's attitude held. Replaces *state with the
+// result kept; returns the diagnosis ("" when the first stands).
+std::string SecondLookAtTheMount(const Survey& survey, StageResults* results,
+                                 const TiePoints& ties,
+                                 const RunOptions& options,
+                                 const ProgressListener& progress,
+                                 const CancellationToken& cancel,
+                                 AdjustState* state,
+                                 std::vector<std::string>* refusals) {
+  const MountAttitudeOptions& mount = options.boresight.attitude;
+  const AttitudeOffset offset = AttitudeOffsetOf(survey, mount, *state);
+  LOG(INFO) << "mount check after the adjustment: body attitude against the "
+               "input's: roll, pitch, yaw "
+            << RadToDeg(offset.mean_rad.x()) << ", "
+            << RadToDeg(offset.mean_rad.y()) << ", "
+            << RadToDeg(offset.mean_rad.z()) << " deg";
+  if (!offset.found) return "";
+  const std::string rig_file = survey.manifest.rig;
+  std::string text =
+      "diagnosis: the adjustment turned the vehicle's attitude from the "
+      "trajectory's by one rotation for the whole survey, beyond the sd the "
+      "trajectory states: " +
+      offset.Describe() + "; a mount rotation that " + rig_file +
+      " does not state turns the cameras so";
+  RunOptions calibrating = options;
+  calibrating.adjustment.rig_calibration.self_calibrate_rig = true;
+  calibrating.adjustment.rig_calibration.boresight_sigma_rad =
+      mount.boresight_sigma_rad;
+  std::vector<std::string> calibrated_refusals;
+  AdjustState calibrated =
+      AdjustAndRematch(survey, results, ties, calibrating, false, progress,
+                       cancel, &calibrated_refusals);
+  const AttitudeOffset left = AttitudeOffsetOf(survey, mount, calibrated);
+  if (!left.found) {
+    const std::vector<Eigen::Isometry3d>& mounts =
+        calibrated.pass.result.T_body_cam;
+    double change_deg = 0.0;
+    for (size_t c = 0; c < mounts.size() && c < survey.rig.cameras.size();
+         ++c) {
+      const Eigen::AngleAxisd turn(
+          mounts[c].linear() *
+          survey.rig.cameras[c].T_body_cam.linear().transpose());
+      change_deg = std::max(change_deg, RadToDeg(turn.angle()));
+    }
+    std::ostringstream more;
+    more.precision(3);
+    more << std::fixed
+         << "; the run adjusted again with the rig's boresight calibrated "
+            "(prior "
+         << RadToDeg(mount.boresight_sigma_rad)
+         << " deg): the cameras turned by up to " << change_deg
+         << " deg and the vehicle's attitude kept the trajectory's "
+            "(adjustment.json rig); state the mount angles in "
+         << rig_file << " if they are known";
+    text += more.str();
+    *state = std::move(calibrated);
+    *refusals = std::move(calibrated_refusals);
+  } else {
+    RunOptions holding = options;
+    // No attitude correction is significant: every axis keeps the input's.
+    holding.adjustment.model.attitude_significance = 1e9;
+    std::vector<std::string> held_refusals;
+    *state = AdjustAndRematch(survey, results, ties, holding, false, progress,
+                              cancel, &held_refusals);
+    *refusals = std::move(held_refusals);
+    text += "; calibrating the rig's boresight did not explain it (" +
+            left.Describe() +
+            "), so the run keeps the trajectory's attitude; state the mount "
+            "angles in " +
+            rig_file;
+  }
+  LOG(WARNING) << text;
+  return text;
+}
+
 // Step "write": every file of the stage, once.
 void WriteAdjustStage(const Survey& survey, const AdjustState& state,
                       const std::string& folder) {
@@ -271,23 +390,23 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
                                         const CancellationToken& cancel) {
   // The output CRS is checked before anything runs.
   OutputCrs::Of(survey);
-  AdjustState state;
-  state.matches = results->Matches();
-  state.decisions = results->Decisions();
   const TiePoints ties = MatchTiePoints(AdjustmentDataOf(survey, {}, {}),
                                         options, progress, cancel);
-  // With the second pass, an adjustment before it may not be the result:
-  // its warnings go to the report (and stderr) only if it is.
-  RunOptions trial = options;
-  trial.adjustment.log_warnings = !options.rematch;
-  Adjust(survey, results, ties, trial, progress, cancel, &state);
   std::vector<std::string> refusals;
-  for (int pass = 0; options.rematch && pass < kMaxRematchPasses; ++pass) {
-    cancel.ThrowIfCancelled();
-    if (!Rematch(survey, results, options, cancel, &state, &refusals)) break;
-    const bool again = pass + 1 < kMaxRematchPasses;
-    Adjust(survey, results, ties, again ? trial : options, progress, cancel,
-           &state);
+  const MountAttitudeOptions& mount = options.boresight.attitude;
+  // The adjustment's warnings are logged once, for the result kept.
+  const bool second_look =
+      mount.enabled && !options.adjustment.rig_calibration.self_calibrate_rig;
+  AdjustState state =
+      AdjustAndRematch(survey, results, ties, options, !second_look, progress,
+                       cancel, &refusals);
+  std::string diagnosis;
+  if (second_look) {
+    diagnosis = SecondLookAtTheMount(survey, results, ties, options, progress,
+                                     cancel, &state, &refusals);
+    for (const std::string& warning : state.pass.result.summary.warnings) {
+      LOG(WARNING) << warning;
+    }
   }
   cancel.ThrowIfCancelled();
   WriteAdjustStage(survey, state, results->folder());
@@ -295,6 +414,7 @@ std::vector<std::string> RunAdjustStage(const Survey& survey,
   results->SetAdjustment(state.pass.result.corrected_samples, state.record);
   std::vector<std::string> warnings = state.warnings;
   warnings.insert(warnings.end(), refusals.begin(), refusals.end());
+  if (!diagnosis.empty()) warnings.insert(warnings.begin(), diagnosis);
   const std::optional<Diagnosis> offset = DiagnoseCommonOffset(
       CrossingCorrections(survey, state.pass.result), survey.manifest.roadmarks,
       survey.manifest.trajectory, DiagnosisOptions());

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "survey/input_error.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -28,19 +29,15 @@ std::string Angles(const MountMisalignment& estimate) {
 }  // namespace
 
 std::string BoresightCheckOptions::Check() const {
-  if (!(min_significant_rad >= 0.0)) {
-    return "min_significant_rad: must be >= 0";
-  }
-  if (!(min_sigmas > 0.0)) return "min_sigmas: must be > 0";
-  if (!(max_applied_sd_rad > 0.0)) return "max_applied_sd_rad: must be > 0";
-  if (!(max_observed_sd_rad >= max_applied_sd_rad)) {
-    return "max_observed_sd_rad: must be >= max_applied_sd_rad";
-  }
-  std::string problem = observations.Check();
-  if (!problem.empty()) return "observations." + problem;
-  problem = estimate.Check();
-  if (!problem.empty()) return "estimate." + problem;
-  return "";
+  OptionCheck check;
+  OPTION_GE(check, min_significant_rad, 0.0);
+  OPTION_GT(check, min_sigmas, 0.0);
+  OPTION_GT(check, max_applied_sd_rad, 0.0);
+  OPTION_GE(check, max_observed_sd_rad, max_applied_sd_rad);
+  OPTION_NESTED(check, attitude);
+  OPTION_NESTED(check, observations);
+  OPTION_NESTED(check, estimate);
+  return check.problem();
 }
 
 BoresightCheck CheckBoresight(const Survey& survey,

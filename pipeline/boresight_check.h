@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "pipeline/mount_attitude_check.h"
 #include "pipeline/progress.h"
 #include "survey/cancellation.h"
 #include "survey/math_util.h"
@@ -49,6 +50,9 @@ struct BoresightCheckOptions {
   // boresight too, with the estimate's sd as its prior
   // (adjustment.rig_calibration).
   bool self_calibrate_after = true;
+  // After the adjustment: a mount rotation too small for this check that
+  // bent the body's attitude (mount_attitude_check.h).
+  MountAttitudeOptions attitude;
   MountObservationOptions observations;
   MountMisalignmentOptions estimate;
 
@@ -65,6 +69,7 @@ struct BoresightCheckOptions {
     // The exposures read at most (tiepoints/mount_observations.h): the
     // check costs the same on a survey of 100 and of 100,000 exposures.
     v("max_exposures", observations.max_exposures);
+    v("attitude", attitude);
   }
 };
 

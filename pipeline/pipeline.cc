@@ -36,6 +36,7 @@ nlohmann::json ReconstructOptionsJson(const RunOptions& options) {
                          {"reconstruction", json["reconstruction"]},
                          {"road_lines", json["road_lines"]}};
   read["reconstruction"].erase("threads");
+  read["boresight"].erase("attitude");  // read by the adjust stage
   return read;
 }
 nlohmann::json MatchOptionsJson(const RunOptions& options) {
@@ -50,6 +51,8 @@ nlohmann::json AdjustOptionsJson(const RunOptions& options) {
         "line_registration", "adjustment", "second_pass", "paint_probe"}) {
     read[key] = json[key];
   }
+  // The boresight's second look is made in the adjust stage.
+  read["boresight_attitude"] = json["boresight"]["attitude"];
   read["adjustment"]["solver"].erase("num_threads");
   read["adjustment"]["solver"].erase("minimizer_progress_to_stdout");
   return read;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -157,25 +158,20 @@ double RobustSigma(std::vector<double> values) {
 }  // namespace
 
 std::string MountMisalignmentOptions::Check() const {
-  if (!(min_step_m > 0.0)) return "min_step_m: must be > 0";
-  if (!(min_road_ahead_m >= 0.0 && max_road_ahead_m > min_road_ahead_m)) {
-    return "min_road_ahead_m, max_road_ahead_m: must be 0 <= min < max";
-  }
-  if (!(max_road_lateral_m > 0.0)) return "max_road_lateral_m: must be > 0";
-  if (!(road_tolerance_m > 0.0)) return "road_tolerance_m: must be > 0";
-  if (min_road_points < 3) return "min_road_points: must be >= 3";
-  if (!(max_road_tilt_rad > 0.0 && max_road_tilt_rad < 1.0)) {
-    return "max_road_tilt_rad: must be in (0, 1)";
-  }
-  if (!(road_bias_sd_rad >= 0.0)) return "road_bias_sd_rad: must be >= 0";
-  if (!(direction_bias_sd_rad >= 0.0)) {
-    return "direction_bias_sd_rad: must be >= 0";
-  }
-  if (!(prior_sd_rad > 0.0)) return "prior_sd_rad: must be > 0";
-  if (min_steps < 1 || min_planes < 1) {
-    return "min_steps, min_planes: must be >= 1";
-  }
-  return "";
+  OptionCheck check;
+  OPTION_GT(check, min_step_m, 0.0);
+  OPTION_GE(check, min_road_ahead_m, 0.0);
+  OPTION_GT(check, max_road_ahead_m, min_road_ahead_m);
+  OPTION_GT(check, max_road_lateral_m, 0.0);
+  OPTION_GT(check, road_tolerance_m, 0.0);
+  OPTION_GE(check, min_road_points, 3);
+  OPTION_IN(check, max_road_tilt_rad, "(", 0.0, 1.0, ")");
+  OPTION_GE(check, road_bias_sd_rad, 0.0);
+  OPTION_GE(check, direction_bias_sd_rad, 0.0);
+  OPTION_GT(check, prior_sd_rad, 0.0);
+  OPTION_GE(check, min_steps, 1);
+  OPTION_GE(check, min_planes, 1);
+  return check.problem();
 }
 
 MountMisalignment EstimateMountMisalignment(

@@ -10,6 +10,7 @@
 
 #include "survey/image_io.h"
 #include "survey/math_util.h"
+#include "survey/option_check.h"
 
 namespace zebrageo {
 namespace {
@@ -93,26 +94,16 @@ void TriangulateStereo(const MountObservationOptions& options,
 }  // namespace
 
 std::string MountObservationOptions::Check() const {
-  if (max_features_per_image < 100) {
-    return "max_features_per_image = " +
-           std::to_string(max_features_per_image) + ": must be >= 100";
-  }
-  if (!(max_descriptor_ratio > 0.0 && max_descriptor_ratio <= 1.0)) {
-    return "max_descriptor_ratio: must be in (0, 1]";
-  }
-  if (!(max_epipolar_distance_px > 0.0)) {
-    return "max_epipolar_distance_px: must be > 0";
-  }
-  if (max_exposures < 0 || (max_exposures > 0 && max_exposures < 2)) {
-    return "max_exposures = " + std::to_string(max_exposures) +
-           ": must be 0 (every exposure) or >= 2";
-  }
-  if (run_length < 2) {
-    return "run_length = " + std::to_string(run_length) + ": must be >= 2";
-  }
-  const std::string odometry_problem = odometry.Check();
-  if (!odometry_problem.empty()) return "odometry." + odometry_problem;
-  return "";
+  OptionCheck check;
+  OPTION_GE(check, max_features_per_image, 100);
+  OPTION_IN(check, max_descriptor_ratio, "(", 0.0, 1.0, "]");
+  OPTION_GT(check, max_epipolar_distance_px, 0.0);
+  OPTION_GE(check, max_exposures, 0);
+  OPTION_REQUIRE(check, max_exposures != 1, max_exposures,
+                 "must be 0 (every exposure) or >= 2");
+  OPTION_GE(check, run_length, 2);
+  OPTION_NESTED(check, odometry);
+  return check.problem();
 }
 
 std::vector<bool> SampledExposures(int num_exposures, int max_exposures,
