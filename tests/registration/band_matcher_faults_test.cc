@@ -13,33 +13,6 @@
 namespace zebrageo {
 namespace {
 
-SyntheticSceneOptions Street(int seed, int crossings = 8,
-                             double spacing_m = 45.0) {
-  SyntheticSceneOptions options;
-  options.seed = seed;
-  options.crossings = RandomCrossings(crossings, spacing_m, seed);
-  return options;
-}
-
-bool HasFault(const MatchResult& result, FaultKind kind,
-              const std::string& crossing_id, int band = 0) {
-  for (const DatabaseFault& fault : result.faults) {
-    if (fault.kind == kind && fault.crossing_id == crossing_id &&
-        (band == 0 || fault.band == band)) {
-      return true;
-    }
-  }
-  return false;
-}
-
-const UnrecognisedMark* Unrecognised(const MatchResult& result,
-                                     const std::string& crossing_id, int band) {
-  for (const UnrecognisedMark& mark : result.unrecognised) {
-    if (mark.crossing_id == crossing_id && mark.band == band) return &mark;
-  }
-  return nullptr;
-}
-
 // A probe that sees as the images do: the database band placed with the
 // pose it is given, brought into the world with the exposure's TRUE pose
 // (where the camera really was), is paint where the street has a band
@@ -79,7 +52,7 @@ MatchInput WithImageLikeProbe(const SyntheticScene& scene,
 
 // The fault rests on the images: bare road where the crossing should be.
 TEST(BandMatcherFaults, ReportsCrossingGoneFromTheStreet) {
-  SyntheticSceneOptions options = Street(9, 5);
+  SyntheticSceneOptions options = RandomStreetScene(9, 5);
   options.crossings[2].in_street = false;
   const SyntheticScene scene = MakeSyntheticScene(options);
   const RoadmarkIndex index(scene.database, scene.frame);
@@ -102,14 +75,14 @@ TEST(BandMatcherFaults, ReportsCrossingGoneFromTheStreet) {
 // The invariant of issue 52: no database fault the images do not show.
 // Without images the same crossing is not recognised, not gone.
 TEST(BandMatcherFaults, WithoutImagesNoCrossingIsGoneFromTheStreet) {
-  SyntheticSceneOptions options = Street(9, 5);
+  SyntheticSceneOptions options = RandomStreetScene(9, 5);
   options.crossings[2].in_street = false;
   const SyntheticScene scene = MakeSyntheticScene(options);
   const RoadmarkIndex index(scene.database, scene.frame);
   const MatchResult result = MatchBands(scene.Input(index), MatchOptions());
   SCOPED_TRACE(result.summary.BriefReport());
   EXPECT_FALSE(HasFault(result, FaultKind::kCrossingGoneFromStreet, "C03"));
-  const UnrecognisedMark* mark = Unrecognised(result, "C03", 0);
+  const UnrecognisedMark* mark = FindUnrecognised(result, "C03", 0);
   ASSERT_NE(mark, nullptr);
   EXPECT_EQ(mark->why, "no images");
 }
@@ -117,7 +90,7 @@ TEST(BandMatcherFaults, WithoutImagesNoCrossingIsGoneFromTheStreet) {
 // A crossing hidden from every view (a truck parked over it): the images
 // show neither paint nor bare road there. Not gone: occluded or not told.
 TEST(BandMatcherFaults, ACrossingHiddenByAVehicleIsNotGoneFromTheStreet) {
-  SyntheticSceneOptions options = Street(9, 5);
+  SyntheticSceneOptions options = RandomStreetScene(9, 5);
   SyntheticCrossingSpec& hidden = options.crossings[2];
   hidden.occluded_bands = hidden.bands;
   hidden.occluded_beyond_m = 0.0;
@@ -132,7 +105,7 @@ TEST(BandMatcherFaults, ACrossingHiddenByAVehicleIsNotGoneFromTheStreet) {
   for (const DatabaseFault& fault : result.faults) {
     EXPECT_NE(fault.crossing_id, "C03") << fault.description;
   }
-  const UnrecognisedMark* mark = Unrecognised(result, "C03", 0);
+  const UnrecognisedMark* mark = FindUnrecognised(result, "C03", 0);
   ASSERT_NE(mark, nullptr);
   EXPECT_EQ(mark->why, "occluded or not told");
   // Every crossing in view is listed with what became of it.
@@ -149,7 +122,7 @@ TEST(BandMatcherFaults, ACrossingHiddenByAVehicleIsNotGoneFromTheStreet) {
 // while the images show its paint: not recognised, never gone.
 TEST(BandMatcherFaults,
      APaintedCrossingNotReconstructedIsNotRecognisedNotGone) {
-  SyntheticSceneOptions options = Street(9, 5);
+  SyntheticSceneOptions options = RandomStreetScene(9, 5);
   SyntheticCrossingSpec& missed = options.crossings[2];
   missed.occluded_bands = missed.bands;
   missed.occluded_beyond_m = 0.0;
@@ -160,7 +133,7 @@ TEST(BandMatcherFaults,
   SCOPED_TRACE(result.summary.BriefReport());
   EXPECT_EQ(ScoreMatches(scene, result.matches).wrong, 0);
   EXPECT_FALSE(HasFault(result, FaultKind::kCrossingGoneFromStreet, "C03"));
-  const UnrecognisedMark* mark = Unrecognised(result, "C03", 0);
+  const UnrecognisedMark* mark = FindUnrecognised(result, "C03", 0);
   ASSERT_NE(mark, nullptr);
   EXPECT_EQ(mark->why, "paint seen");
 }
@@ -170,7 +143,7 @@ TEST(BandMatcherFaults,
 TEST(BandMatcherFaults, ReportsABandMissingFromTheStreetWithItsImageEvidence) {
   int faults = 0;
   for (int seed = 1; seed <= 3; ++seed) {
-    SyntheticSceneOptions options = Street(seed);
+    SyntheticSceneOptions options = RandomStreetScene(seed);
     SyntheticCrossingSpec& lacking = options.crossings[1];
     lacking.street_lacks = {3};
     const SyntheticScene scene = MakeSyntheticScene(options);

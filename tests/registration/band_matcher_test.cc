@@ -46,38 +46,11 @@ int CountDecisions(const MatchResult& result, Decision decision,
   return n;
 }
 
-bool HasFault(const MatchResult& result, FaultKind kind,
-              const std::string& crossing_id, int band = 0) {
-  for (const DatabaseFault& fault : result.faults) {
-    if (fault.kind == kind && fault.crossing_id == crossing_id &&
-        (band == 0 || fault.band == band)) {
-      return true;
-    }
-  }
-  return false;
-}
-
-const UnrecognisedMark* Unrecognised(const MatchResult& result,
-                                     const std::string& crossing_id, int band) {
-  for (const UnrecognisedMark& mark : result.unrecognised) {
-    if (mark.crossing_id == crossing_id && mark.band == band) return &mark;
-  }
-  return nullptr;
-}
-
 double MatchedShare(const MatchScore& score) {
   return score.crossings_eligible.empty()
              ? 1.0
              : static_cast<double>(score.crossings_matched.size()) /
                    score.crossings_eligible.size();
-}
-
-SyntheticSceneOptions Street(int seed, int crossings = 8,
-                             double spacing_m = 45.0) {
-  SyntheticSceneOptions options;
-  options.seed = seed;
-  options.crossings = RandomCrossings(crossings, spacing_m, seed);
-  return options;
 }
 
 TEST(MatchOptions, CheckNamesTheFieldItsValueAndTheConstraint) {
@@ -109,7 +82,7 @@ TEST(BandMatcher, ReportsInvalidOptionsInsteadOfRunning) {
 
 TEST(BandMatcher, MatchesAStreetWithTwoMetresOfDriftWithoutAWrongVertex) {
   for (int seed = 1; seed <= 3; ++seed) {
-    const SceneRun run = MatchScene(Street(seed));
+    const SceneRun run = MatchScene(RandomStreetScene(seed));
     SCOPED_TRACE("seed " + std::to_string(seed) + ": " +
                  run.result.summary.BriefReport());
     EXPECT_EQ(run.score.wrong, 0);
@@ -122,7 +95,7 @@ TEST(BandMatcher, MatchesAStreetWithTwoMetresOfDriftWithoutAWrongVertex) {
 TEST(BandMatcher, RecoversTwoMetreDriftDespiteOneMetrePeriod) {
   // The drift is two band periods straight across the crossings: a nearest-
   // band match would be off by two bands everywhere.
-  SyntheticSceneOptions options = Street(4);
+  SyntheticSceneOptions options = RandomStreetScene(4);
   options.drift_m = 0.0;
   options.constant_shift_m = Eigen::Vector2d(0.03, 2.0);
   const SceneRun run = MatchScene(options);
@@ -136,7 +109,7 @@ TEST(BandMatcher, RecoversTwoMetreDriftDespiteOneMetrePeriod) {
 }
 
 TEST(BandMatcher, RecoversThreeMetreDriftOfAnOutage) {
-  SyntheticSceneOptions options = Street(5);
+  SyntheticSceneOptions options = RandomStreetScene(5);
   options.drift_m = 3.0;
   options.heading_drift_rad = 0.01;
   const SceneRun run = MatchScene(options);
@@ -150,7 +123,7 @@ TEST(BandMatcher, NeverGuessesWhenTheDriftOutrunsContinuity) {
   // one crossing to the next 5 s later. Crossings seen end to end still
   // match; the others are refused, none is guessed.
   for (int seed = 5; seed <= 7; ++seed) {
-    SyntheticSceneOptions options = Street(seed);
+    SyntheticSceneOptions options = RandomStreetScene(seed);
     options.drift_m = 3.0;
     options.drift_turn_rate_rad_per_s = 0.03;
     options.heading_drift_rad = 0.01;
@@ -234,7 +207,7 @@ TEST(BandMatcher, IgnoresAnEndBandHiddenFromSomeViewsByAParkedVehicle) {
   // Band 1 of every crossing is hidden until the vehicle is within 9 m:
   // the far views must not count its absence against the right offset.
   for (int seed = 1; seed <= 3; ++seed) {
-    SyntheticSceneOptions options = Street(seed);
+    SyntheticSceneOptions options = RandomStreetScene(seed);
     for (SyntheticCrossingSpec& c : options.crossings) {
       c.occluded_bands = 1;
       c.occluded_beyond_m = 9.0;
@@ -249,7 +222,7 @@ TEST(BandMatcher, IgnoresAnEndBandHiddenFromSomeViewsByAParkedVehicle) {
 TEST(BandMatcher, WithBothEndsRequiredNeverGuessesAnEndBandHiddenFromAllViews) {
   // Bands 1 and 2 are never seen: from the bands alone this is a crossing
   // two bands narrower. Requiring both ends to agree refuses it.
-  SyntheticSceneOptions options = Street(5);
+  SyntheticSceneOptions options = RandomStreetScene(5);
   for (SyntheticCrossingSpec& c : options.crossings) {
     c.occluded_bands = 2;
     c.occluded_beyond_m = 6.0;
@@ -270,7 +243,7 @@ TEST(BandMatcher,
   // where the street has a band, the vehicle where it hides band 1, bare
   // road elsewhere) must not.
   for (int seed = 1; seed <= 3; ++seed) {
-    SyntheticSceneOptions options = Street(seed);
+    SyntheticSceneOptions options = RandomStreetScene(seed);
     for (SyntheticCrossingSpec& c : options.crossings) {
       c.occluded_bands = 1;
       c.occluded_beyond_m = 1e-3;
@@ -329,7 +302,7 @@ TEST(BandMatcher, ADatabaseLackingItsLastBandWithBandOneHiddenIsRefused) {
   // 1..n-1; the decision would rest on band counts at one end: refused,
   // never guessed.
   for (int seed = 1; seed <= 3; ++seed) {
-    SyntheticSceneOptions options = Street(40 + seed, 5);
+    SyntheticSceneOptions options = RandomStreetScene(40 + seed, 5);
     for (SyntheticCrossingSpec& c : options.crossings) {
       c.database_lacks = {c.bands};
       c.occluded_bands = 1;
@@ -349,7 +322,7 @@ TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
   // The database has crossing C03 one band period off (a wrong survey): it
   // still fits perfectly alone, but implies a correction 1 m away from the
   // crossings before and after it.
-  SyntheticSceneOptions options = Street(8, 5, 30.0);
+  SyntheticSceneOptions options = RandomStreetScene(8, 5, 30.0);
   options.crossings[2].database_shift_m = Eigen::Vector2d(0.0, 1.0);
   options.drift_turn_rate_rad_per_s = 0.0;
   const SceneRun run = MatchScene(options);
@@ -361,7 +334,7 @@ TEST(BandMatcher, RejectsMatchInconsistentWithNeighbours) {
 }
 
 TEST(BandMatcher, ReportsCrossingMissingFromTheDatabase) {
-  SyntheticSceneOptions options = Street(10, 5);
+  SyntheticSceneOptions options = RandomStreetScene(10, 5);
   options.crossings[1].in_database = false;
   const SceneRun run = MatchScene(options);
   SCOPED_TRACE(run.result.summary.BriefReport());
@@ -378,7 +351,7 @@ TEST(BandMatcher, ReportsCrossingMissingFromTheDatabase) {
 }
 
 TEST(BandMatcher, ReportsBandsMissingOnEitherSideWithoutGuessing) {
-  SyntheticSceneOptions options = Street(11, 6);
+  SyntheticSceneOptions options = RandomStreetScene(11, 6);
   for (SyntheticCrossingSpec& c : options.crossings) c.bands = 6;
   options.crossings[1].street_lacks = {options.crossings[1].bands};
   options.crossings[3].database_lacks = {1};
@@ -392,12 +365,12 @@ TEST(BandMatcher, ReportsBandsMissingOnEitherSideWithoutGuessing) {
   // Without images: not recognised, not missing from the street.
   EXPECT_FALSE(
       HasFault(run.result, FaultKind::kBandMissingFromStreet, "C02", 6));
-  ASSERT_NE(Unrecognised(run.result, "C02", 6), nullptr);
-  EXPECT_EQ(Unrecognised(run.result, "C02", 6)->why, "no images");
+  ASSERT_NE(FindUnrecognised(run.result, "C02", 6), nullptr);
+  EXPECT_EQ(FindUnrecognised(run.result, "C02", 6)->why, "no images");
 }
 
 TEST(BandMatcher, ReportsARepaintedCrossingShiftedByDecimetres) {
-  SyntheticSceneOptions options = Street(12, 5);
+  SyntheticSceneOptions options = RandomStreetScene(12, 5);
   options.crossings[2].database_shift_m = Eigen::Vector2d(0.35, 0.0);
   options.drift_turn_rate_rad_per_s = 0.0;
   options.database_offset_m = 0.02;
@@ -409,7 +382,7 @@ TEST(BandMatcher, ReportsARepaintedCrossingShiftedByDecimetres) {
 }
 
 TEST(BandMatcher, MapsVerticesToDatabaseCornersWhateverTheRingOrder) {
-  const SceneRun run = MatchScene(Street(13, 3));
+  const SceneRun run = MatchScene(RandomStreetScene(13, 3));
   ASSERT_FALSE(run.result.matches.empty());
   std::set<int> db_vertices;
   std::set<int> vertices;
@@ -427,7 +400,7 @@ TEST(BandMatcher, AnEndSeenShortLosesItsTwoCornersNotTheBand) {
   // image's edge, worn paint): those two corners are off their database
   // corners by more than a wrong match is (0.2 m), yet the band is still
   // the database's across its axis, and its near corners are control.
-  SyntheticScene scene = MakeSyntheticScene(Street(15, 3));
+  SyntheticScene scene = MakeSyntheticScene(RandomStreetScene(15, 3));
   // (exposure, band, vertex) of the cut corners and of the others.
   std::set<std::tuple<int64_t, int64_t, int>> cut, kept;
   for (CrossingObservation& o : scene.observations) {
@@ -469,8 +442,8 @@ TEST(BandMatcher, AnEndSeenShortLosesItsTwoCornersNotTheBand) {
 }
 
 TEST(BandMatcher, IsDeterministic) {
-  const SceneRun a = MatchScene(Street(14, 3));
-  const SceneRun b = MatchScene(Street(14, 3));
+  const SceneRun a = MatchScene(RandomStreetScene(14, 3));
+  const SceneRun b = MatchScene(RandomStreetScene(14, 3));
   ASSERT_EQ(a.result.matches.size(), b.result.matches.size());
   for (size_t i = 0; i < a.result.matches.size(); ++i) {
     EXPECT_EQ(a.result.matches[i].band_id, b.result.matches[i].band_id);

@@ -343,6 +343,34 @@ SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   return scene;
 }
 
+SyntheticSceneOptions RandomStreetScene(int seed, int crossings,
+                                        double spacing_m) {
+  SyntheticSceneOptions options;
+  options.seed = seed;
+  options.crossings = RandomCrossings(crossings, spacing_m, seed);
+  return options;
+}
+
+bool HasFault(const MatchResult& result, FaultKind kind,
+              const std::string& crossing_id, int band) {
+  for (const DatabaseFault& fault : result.faults) {
+    if (fault.kind == kind && fault.crossing_id == crossing_id &&
+        (band == 0 || fault.band == band)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+const UnrecognisedMark* FindUnrecognised(const MatchResult& result,
+                                         const std::string& crossing_id,
+                                         int band) {
+  for (const UnrecognisedMark& mark : result.unrecognised) {
+    if (mark.crossing_id == crossing_id && mark.band == band) return &mark;
+  }
+  return nullptr;
+}
+
 MatchScore ScoreMatches(const SyntheticScene& scene,
                         const std::vector<VertexMatch>& matches) {
   std::map<std::pair<int64_t, int64_t>, const ObservedBand*> bands;

@@ -106,6 +106,20 @@ SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options);
 std::vector<SyntheticCrossingSpec> RandomCrossings(int count, double spacing_m,
                                                    int seed);
 
+// A scene of `crossings` random crossings every `spacing_m` (RandomCrossings).
+SyntheticSceneOptions RandomStreetScene(int seed, int crossings = 8,
+                                        double spacing_m = 45.0);
+
+// Whether `result` claims a fault of `kind` on `crossing_id` (on `band`, or
+// on any band when `band` is 0).
+bool HasFault(const MatchResult& result, FaultKind kind,
+              const std::string& crossing_id, int band = 0);
+
+// The mark `result` lists as not recognised for that band, or null.
+const UnrecognisedMark* FindUnrecognised(const MatchResult& result,
+                                         const std::string& crossing_id,
+                                         int band);
+
 // Scores matches against the scene's truth like score_results.py: a match
 // is wrong if the reconstructed vertex placed with the TRUE pose is more than
 // 0.2 m from the named truth vertex, or names a band not in the street.
