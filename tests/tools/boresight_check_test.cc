@@ -64,6 +64,24 @@ void WriteTurnedCase(const Eigen::Matrix3d& E, const std::string& folder) {
   WriteRig(rig, folder + "/rig.yaml");
 }
 
+// Scores `results` against the case as shipped, whose rig is the truth (the
+// scorer places the true cameras with the survey's rig.yaml): no wrong
+// vertex match, poses no worse than the input and H within 10 cm. Returns
+// the poses scorer's text.
+std::string ExpectNoWrongMatchNoWorse(const std::string& results,
+                                      const TemporaryFolder& folder) {
+  const Score match = ScoreResults("match", CaseFolder(), results,
+                                   "--max-wrong 0", folder.Path("match.out"));
+  std::cout << match.text;
+  EXPECT_TRUE(match.passed);
+  const Score poses = ScoreResults("poses", CaseFolder(), results,
+                                   "--not-worse", folder.Path("poses.out"));
+  std::cout << poses.text;
+  EXPECT_TRUE(poses.passed);
+  EXPECT_LE(HorizontalAfterM(poses.text), 0.10);
+  return poses.text;
+}
+
 TEST(BoresightCheck, AnUnstatedMountIsEstimatedOrRefusedNeverWorse) {
   if (!fs::exists(CaseFolder() + "/survey.yaml")) {
     GTEST_SKIP() << "../shared/datasets/field-cases/amiens-short is absent";
@@ -112,23 +130,13 @@ TEST(BoresightCheck, AnUnstatedMountIsEstimatedOrRefusedNeverWorse) {
     }
   }
   EXPECT_GE(axes_applied, 2);
-  // Scored against the case as shipped: its rig is the truth (the
-  // scorer places the true cameras with the survey's rig.yaml).
-  const Score match = ScoreResults("match", CaseFolder(), results,
-                                   "--max-wrong 0", folder.Path("match.out"));
-  std::cout << match.text;
-  EXPECT_TRUE(match.passed);
-  const Score poses = ScoreResults("poses", CaseFolder(), results,
-                                   "--not-worse", folder.Path("poses.out"));
-  std::cout << poses.text;
-  EXPECT_TRUE(poses.passed);
-  EXPECT_LE(HorizontalAfterM(poses.text), 0.10);
+  const std::string poses_text = ExpectNoWrongMatchNoWorse(results, folder);
   // The cameras' attitude: the input's, with the rig as given, is off by
   // E's angle (1.15 deg); the result must be far closer to the truth.
   std::smatch attitude;
-  ASSERT_TRUE(std::regex_search(poses.text, attitude,
+  ASSERT_TRUE(std::regex_search(poses_text, attitude,
                                 std::regex(R"(after: .* att ([0-9.]+) deg;)")))
-      << poses.text;
+      << poses_text;
   EXPECT_LE(std::stod(attitude[1].str()), 0.25);
 }
 
@@ -196,15 +204,7 @@ TEST(SmallMountYaw, EndsNoWorseThanTheInputOrExits1) {
   std::cout << "[ HEADING  ] RMS vs truth: input " << input_deg
             << " deg, after " << after_deg << " deg\n";
   EXPECT_LE(after_deg, input_deg + 0.01);
-  const Score match = ScoreResults("match", CaseFolder(), results,
-                                   "--max-wrong 0", folder.Path("match.out"));
-  std::cout << match.text;
-  EXPECT_TRUE(match.passed);
-  const Score poses = ScoreResults("poses", CaseFolder(), results,
-                                   "--not-worse", folder.Path("poses.out"));
-  std::cout << poses.text;
-  EXPECT_TRUE(poses.passed);
-  EXPECT_LE(HorizontalAfterM(poses.text), 0.10);
+  ExpectNoWrongMatchNoWorse(results, folder);
 }
 
 }  // namespace
