@@ -97,6 +97,7 @@ std::string MatchOptions::Check() const {
   OPTION_GT(check, max_missing_views, 0);
   OPTION_GE(check, contradiction_weight, 0.0);
   OPTION_GE(check, unexplained_band_weight, 0.0);
+  OPTION_GE(check, max_unexplained_per_hit, 0.0);
   OPTION_GE(check, visibility_margin_px, 0.0);
   OPTION_GE(check, visibility_safety_px, 0.0);
   OPTION_GE(check, visibility_range_m, 0.0);

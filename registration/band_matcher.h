@@ -116,6 +116,13 @@ struct MatchOptions {
   int max_missing_views = 2;
   double contradiction_weight = 2.0;
   double unexplained_band_weight = 0.5;
+  // A fit that leaves more observed bands outside every crossing than this
+  // many per band it explains is refused, whatever its margin: paint the
+  // database lacks next to the bands it places says the place is wrong
+  // (with the stated position sd too small after a GNSS outage, the one
+  // offset inside the gate can put most of a crossing's bands beyond its
+  // end and still win alone).
+  double max_unexplained_per_hit = 1.0;
   // Visibility of database bands (for missing-band evidence): a band counts
   // as "should have been seen" only when all its corners project at least
   // this far inside both images of a stereo pair...
@@ -232,6 +239,7 @@ struct MatchOptions {
     v("max_missing_views", max_missing_views);
     v("contradiction_weight", contradiction_weight);
     v("unexplained_band_weight", unexplained_band_weight);
+    v("max_unexplained_per_hit", max_unexplained_per_hit);
     v("visibility_margin_px", visibility_margin_px);
     v("visibility_safety_px", visibility_safety_px);
     v("visibility_range_m", visibility_range_m);

@@ -242,6 +242,13 @@ void DecideAlone(int o, MatchState* state) {
                 " observed band(s) in gaps of crossing " + ev.crossing_id;
     return;
   }
+  if (ev.unexplained > options.max_unexplained_per_hit * ev.hits) {
+    ev.reason = "the best fit leaves " + std::to_string(ev.unexplained) +
+                " observed band(s) outside every crossing against " +
+                std::to_string(ev.hits) + " it explains on crossing " +
+                ev.crossing_id;
+    return;
+  }
   if (robust_margin < options.min_margin) {
     state->ambiguous[o] = true;
     ev.reason = "ambiguous: " + ev.runner_up + " scores " +
