@@ -260,7 +260,11 @@ std::string SecondLookAtTheMount(const Survey& survey, StageResults* results,
                "input's: roll, pitch, yaw "
             << RadToDeg(offset.mean_rad.x()) << ", "
             << RadToDeg(offset.mean_rad.y()) << ", "
-            << RadToDeg(offset.mean_rad.z()) << " deg";
+            << RadToDeg(offset.mean_rad.z())
+            << " deg; heading off the course over ground (median over "
+            << offset.course_chords << " chords): the input's "
+            << RadToDeg(offset.input_course_departure_rad) << ", the corrected "
+            << RadToDeg(offset.corrected_course_departure_rad) << " deg";
   if (!offset.found) return "";
   const std::string rig_file = survey.manifest.rig;
   std::string text =

@@ -178,8 +178,8 @@ TEST(SmallMountYaw, EndsNoWorseThanTheInputOrExits1) {
       Eigen::AngleAxisd(DegToRad(0.3), Eigen::Vector3d::UnitZ()).matrix(),
       survey);
   const std::string results = folder.Path("results");
-  // The second look after the adjustment (off by default:
-  // pipeline/mount_attitude_check.h).
+  // The second look after the adjustment (pipeline/mount_attitude_check.h;
+  // on by default, stated so that the test holds it whatever the default).
   const std::string options = folder.Path("options.json");
   std::ofstream(options) << R"({"boresight": {"attitude": {"enabled": true}}})";
   const int code = RunZebrageo(
