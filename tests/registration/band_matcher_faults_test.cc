@@ -50,14 +50,20 @@ MatchInput WithImageLikeProbe(const SyntheticScene& scene,
   return input;
 }
 
+// The matcher on `scene` with the probe above.
+MatchResult MatchWithImageLikeProbe(const SyntheticScene& scene,
+                                    const std::string& hidden_crossing = "") {
+  const RoadmarkIndex index(scene.database, scene.frame);
+  return MatchBands(WithImageLikeProbe(scene, index, hidden_crossing),
+                    MatchOptions());
+}
+
 // The fault rests on the images: bare road where the crossing should be.
 TEST(BandMatcherFaults, ReportsCrossingGoneFromTheStreet) {
   SyntheticSceneOptions options = RandomStreetScene(9, 5);
   options.crossings[2].in_street = false;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const RoadmarkIndex index(scene.database, scene.frame);
-  const MatchResult result =
-      MatchBands(WithImageLikeProbe(scene, index), MatchOptions());
+  const MatchResult result = MatchWithImageLikeProbe(scene);
   SCOPED_TRACE(result.summary.BriefReport());
   EXPECT_EQ(ScoreMatches(scene, result.matches).wrong, 0);
   EXPECT_TRUE(HasFault(result, FaultKind::kCrossingGoneFromStreet, "C03"));
@@ -95,11 +101,9 @@ TEST(BandMatcherFaults, ACrossingHiddenByAVehicleIsNotGoneFromTheStreet) {
   hidden.occluded_bands = hidden.bands;
   hidden.occluded_beyond_m = 0.0;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const RoadmarkIndex index(scene.database, scene.frame);
   // The probe: the vehicle over C03's bands, paint on the others' bands,
   // bare road elsewhere.
-  const MatchInput input = WithImageLikeProbe(scene, index, "C03");
-  const MatchResult result = MatchBands(input, MatchOptions());
+  const MatchResult result = MatchWithImageLikeProbe(scene, "C03");
   SCOPED_TRACE(result.summary.BriefReport());
   EXPECT_EQ(ScoreMatches(scene, result.matches).wrong, 0);
   for (const DatabaseFault& fault : result.faults) {
@@ -127,9 +131,7 @@ TEST(BandMatcherFaults,
   missed.occluded_bands = missed.bands;
   missed.occluded_beyond_m = 0.0;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const RoadmarkIndex index(scene.database, scene.frame);
-  const MatchResult result =
-      MatchBands(WithImageLikeProbe(scene, index), MatchOptions());
+  const MatchResult result = MatchWithImageLikeProbe(scene);
   SCOPED_TRACE(result.summary.BriefReport());
   EXPECT_EQ(ScoreMatches(scene, result.matches).wrong, 0);
   EXPECT_FALSE(HasFault(result, FaultKind::kCrossingGoneFromStreet, "C03"));
@@ -147,9 +149,7 @@ TEST(BandMatcherFaults, ReportsABandMissingFromTheStreetWithItsImageEvidence) {
     SyntheticCrossingSpec& lacking = options.crossings[1];
     lacking.street_lacks = {3};
     const SyntheticScene scene = MakeSyntheticScene(options);
-    const RoadmarkIndex index(scene.database, scene.frame);
-    const MatchResult result =
-        MatchBands(WithImageLikeProbe(scene, index), MatchOptions());
+    const MatchResult result = MatchWithImageLikeProbe(scene);
     SCOPED_TRACE(result.summary.BriefReport());
     EXPECT_EQ(ScoreMatches(scene, result.matches).wrong, 0);
     for (const DatabaseFault& fault : result.faults) {
