@@ -140,11 +140,17 @@ void ShadeTruck(const ParkedVehicle& truck, const VerticalBox& box,
   const bool side = face >= 2;
   const double across = side ? u : v;  // along the face
   *key = Key(kVehicle, id * 8);
+  // Grime and print at a few centimetres: the fine texture of a real body.
+  const float grain =
+      0.92f + 0.16f * ValueNoise(across / 0.05, h / 0.05, truck.salt + 11);
   if (h < 0.5 && face != 4) {
+    // Bumper, mudguards, axles and tyres: dark, with their edges.
     const double wheel = std::abs(std::abs(across) -
                                   (side ? box.half_u - 1.2 : box.half_v - 0.4));
     const bool tyre = side && std::hypot(wheel, h - 0.5) < 0.5;
-    *value = tyre ? 28.0f : 18.0f;
+    const bool bumper =
+        h > 0.3 && std::fmod(std::abs(across) + 10.0, 0.7) < 0.5;
+    *value = (tyre ? 28.0f : bumper ? 60.0f : 18.0f) * grain;
     *key = Key(kVehicle, id * 8 + (tyre ? 3 : 1));
     return;
   }
@@ -152,20 +158,20 @@ void ShadeTruck(const ParkedVehicle& truck, const VerticalBox& box,
   const float dirt =
       0.82f + 0.3f * ValueNoise(across / 0.6, h / 0.6, truck.salt + face);
   if (cab) {
-    *value = 0.7f * truck.body_tone * dirt;
+    *value = 0.7f * truck.body_tone * dirt * grain;
     *key = Key(kVehicle, id * 8 + 6);
     if (h > 0.55 * height && h < 0.85 * height &&
         (face == 0 || (side && u < -box.half_u + 1.6))) {
-      *value = 45.0f;  // windscreen, side window
+      *value = 45.0f * grain;  // windscreen, side window
       *key = Key(kVehicle, id * 8 + 4);
     }
     return;
   }
-  // Vertical ribs every 0.3 m, lettering: dark blocks on a band of the
-  // side, a panel seam near the top.
+  // Vertical ribs every 0.3 m, lettering: dark blocks over the sides, a
+  // panel seam near the top.
   const double rib = std::fmod(std::abs(across) + 10.0, 0.3);
-  float tone = truck.body_tone * dirt * (rib < 0.04 ? 0.78f : 1.0f);
-  if (side && h > 1.2 && h < 2.4) {
+  float tone = truck.body_tone * dirt * grain * (rib < 0.04 ? 0.78f : 1.0f);
+  if (h > 0.7 && h < height - 0.4) {
     const int64_t gx = static_cast<int64_t>(std::floor(across / 0.18));
     const int64_t gy = static_cast<int64_t>(std::floor(h / 0.25));
     if (HashToUnit(HashLattice(gx, gy, truck.salt + 9)) < 0.35f) {

@@ -158,22 +158,27 @@ void PaintSquareRows(const BesideDraws& d, double size, int ci, World* world) {
   }
 }
 
-// A column of squares along the bands, one period beyond the last band
-// (when the street has room for it).
+// A column of squares along the bands, one period beyond the last band,
+// or before the first when the street has no room beyond the last.
 void PaintSquareColumn(double size, int ci, World* world) {
   Crossing& c = world->crossings[ci];
   double lo = 0.0, hi = 0.0;
   OffsetRange(*world, &lo, &hi);
-  const double o0 = c.first_offset_m + c.num_street_bands * c.band_period_m;
-  const double o1 = o0 + std::min(size, c.band_width_m);
-  if (c.num_street_bands < 1 || o1 > hi) return;
+  const double width = std::min(size, c.band_width_m);
+  double o0 = c.first_offset_m + c.num_street_bands * c.band_period_m;
+  std::string where = "beyond band " + std::to_string(c.num_street_bands);
+  if (o0 + width > hi) {
+    o0 = c.first_offset_m - c.band_period_m;
+    where = "before band 1";
+  }
+  const double o1 = o0 + width;
+  if (c.num_street_bands < 1 || o1 > hi || o0 < lo) return;
   const double half = 0.5 * c.band_length_m;
   for (double a = -half; a + size <= half + 1e-9; a += 2.0 * size) {
     AddMark(world, "square", ci, CrossingQuad(c, o0, o1, a, a + size),
             kWhiteTone, true, c.salt + 5200 + world->beside_marks.size());
   }
-  c.beside.push_back("square column beyond band " +
-                     std::to_string(c.num_street_bands));
+  c.beside.push_back("square column " + where);
 }
 
 // Give-way teeth across the driving lane (the right half), pointing at the
