@@ -179,10 +179,10 @@ PaintEvidence ImagePaintProbe::Classify(
   if (image == nullptr) return PaintEvidence::kUnknown;
   const Eigen::Isometry3d T_cam_enu =
       (pose.T_enu_body() * survey_.rig.cameras[camera_].T_body_cam).inverse();
-  // Paint is paint; anything else is first asked whether something stands
-  // over the place (a dark, even vehicle side looks like bare road).
+  // Every verdict is first checked for something standing over the place:
+  // a dark, even vehicle side looks like bare road, a white one like paint
+  // (measured: a truck over a band read as paint in 12 of 17 views).
   auto unless_occluded = [&](PaintEvidence evidence) {
-    if (evidence == PaintEvidence::kPaint) return evidence;
     return StandsAboveRoad(exposure_id, pose, band) ? PaintEvidence::kOccluded
                                                     : evidence;
   };

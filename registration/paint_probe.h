@@ -77,10 +77,10 @@ struct PaintProbeOptions {
   // ray, one pixel of disparity a step). A point with texture (window sd
   // at least occlusion_min_texture grey levels) stands above the road when
   // its best match above beats the road's by occlusion_ncc_margin at
-  // correlation occlusion_min_ncc; the place is occluded when at least
-  // occlusion_min_points and occlusion_min_share of the textured points
-  // do. Measured: a truck over a band, all of 30-40 textured points above
-  // the road; bare asphalt, none (docs/results.md, issue 52).
+  // correlation occlusion_min_ncc, on the road when the road's match
+  // reaches occlusion_min_ncc (else it does not vote); the place is
+  // occluded when at least occlusion_min_points and occlusion_min_share of
+  // the votes are above the road (docs/results.md, issue 52).
   int occlusion_window_px = 5;
   double occlusion_min_height_m = 0.5;
   double occlusion_min_texture = 4.0;

@@ -103,7 +103,8 @@ bool ImagePaintProbe::MeasureStandsAboveRoad(int64_t exposure_id,
   const double baseline = (T_r_enu.inverse().translation() - centre).norm();
   const int half = options_.occlusion_window_px / 2;
   // A grid of 8 x 5 points over the middle of the place, visited in a
-  // scattered order, until kMaxTextured of them have texture.
+  // scattered order, until kMaxTextured of them have voted (textured, and
+  // matching clearly on the road or above it).
   constexpr int kAlong = 8;
   constexpr int kAcross = 5;
   constexpr int kMaxTextured = 16;
@@ -151,10 +152,14 @@ bool ImagePaintProbe::MeasureStandsAboveRoad(int64_t exposure_id,
       if (x_r.z() < 0.3 || !cam_r.Project(x_r, &uv_r)) continue;
       best = std::max(best, Ncc(a, norm_a, right_image, uv_r, half, &scratch));
     }
-    ++textured;
+    // A vote only where one surface matches clearly (image noise alone
+    // matches neither).
     if (best >= options_.occlusion_min_ncc &&
         best >= on_road + options_.occlusion_ncc_margin) {
       ++above;
+      ++textured;
+    } else if (on_road >= options_.occlusion_min_ncc) {
+      ++textured;
     }
   }
   VLOG(2) << "occlusion probe: exposure " << exposure_id << " textured "
