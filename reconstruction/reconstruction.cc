@@ -387,6 +387,37 @@ RoadPlane InitialRoadPlane(const Survey& survey, const StereoPairs& pairs,
   return running;
 }
 
+// The pairs rectified over the initial road plane `*initial`; when that
+// plane leaves fewer pairs usable than the nominal one did (`nominal_pairs`:
+// e.g. a plane fitted to left and right images exchanged, tilted so that
+// it passes above a camera), it is no road: the nominal plane and its
+// pairs are kept, `*initial` set to it, and a warning says so.
+StereoPairs PairsOnInitialPlane(const Rig& rig, const RoadPlane& nominal,
+                                const ReconstructionOptions& options,
+                                StereoPairs nominal_pairs, RoadPlane* initial,
+                                ReconstructionSummary* summary) {
+  const auto usable = [](const StereoPairs& pairs) {
+    return std::count_if(pairs.begin(), pairs.end(),
+                         [](const auto& p) { return p != nullptr; });
+  };
+  ReconstructionSummary trial;
+  StereoPairs pairs = MakePairs(rig, *initial, options, &trial);
+  if (usable(pairs) >= usable(nominal_pairs)) {
+    summary->warnings.insert(summary->warnings.end(), trial.warnings.begin(),
+                             trial.warnings.end());
+    return pairs;
+  }
+  summary->warnings.push_back(
+      "the road plane found on the initialisation exposures leaves " +
+      std::to_string(usable(nominal_pairs) - usable(pairs)) +
+      " stereo pair(s) without a road to rectify over (" +
+      trial.warnings.front() +
+      "): using the nominal plane (nominal_camera_height_m)");
+  LOG(WARNING) << summary->warnings.back();
+  *initial = nominal;
+  return nominal_pairs;
+}
+
 // Step 2: all exposures, in time order, batch by batch, each batch with
 // the running road plane of the batches before it.
 std::vector<ExposureResult> ProcessExposures(
@@ -533,10 +564,11 @@ ReconstructionSummary ReconstructSurvey(
         summary.warnings.front();
     return summary;
   }
-  const RoadPlane initial =
+  RoadPlane initial =
       InitialRoadPlane(survey, pairs, options, threads, nominal, &summary);
+  pairs = PairsOnInitialPlane(rig, nominal, options, std::move(pairs), &initial,
+                              &summary);
   summary.initial_road_plane = initial;
-  pairs = MakePairs(rig, initial, options, &summary);
   RoadPlaneTracker running(initial, options.search);
   const std::vector<ExposureResult> results = ProcessExposures(
       survey, pairs, options, threads, progress, cancel, &running);

@@ -42,7 +42,7 @@ struct RectificationOptions {
   // ... and within this distance across (along the baseline) from the
   // middle of the two cameras: a road with its sidewalks; farther is
   // facades and parked cars, and costs time.
-  double max_lateral_m = 9.0;
+  double max_lateral_m = 14.0;
   // Largest rectified image side, pixels: a guard against absurd rigs.
   int max_image_side_px = 4096;
   // Pixels closer than this to the border of either original image are

@@ -9,10 +9,11 @@
 namespace zebrageo::support {
 namespace {
 
-GeometryRunResult RunSeed(uint64_t seed) {
+GeometryRunResult RunSeed(uint64_t seed, int junctions = -1) {
   FLAGS_minloglevel = google::GLOG_ERROR;
   GeometrySweepOptions options;
   options.max_road_length_m = 400.0;
+  options.junctions = junctions;
   return RunGeometrySurvey(seed, options);
 }
 
@@ -36,9 +37,11 @@ TEST(GeometryRegressions, Seed743WornEndBandIsNotMatchedABandOff) {
 // switch after it: an error model fitted on the one crossing alone (at its
 // floor across the track) made the switch impossible and the crossing a
 // blunder, and the lines alone then slid the trajectory 1.85 m along the
-// track on a grade (H 72.5 -> 101.2 cm).
+// track on a grade (H 72.5 -> 101.2 cm). Without its junction: since the
+// surveys with junctions have a wide-angle rig (issue 51), its side-street
+// crossing is matched too, and the case is no longer one crossing.
 TEST(GeometryRegressions, Seed844OneCrossingAndAMultipathSwitchSeenByLines) {
-  const GeometryRunResult r = RunSeed(844);
+  const GeometryRunResult r = RunSeed(844, 0);
   ASSERT_EQ(r.error, "");
   ASSERT_TRUE(r.usable) << r.message;
   EXPECT_EQ(r.wrong, 0) << r.Line();

@@ -161,5 +161,34 @@ TEST(Junctions, RandomPresetDrawsThemInHalfTheSurveysOnly) {
   EXPECT_LT(with, 45);
 }
 
+// With junctions the rig is wide-angle (70-100 degrees across), its
+// distortion the same function of the pixel radius as the one drawn, and
+// the options valid.
+TEST(Junctions, RandomPresetWithJunctionsGivenHasAWideAngleRig) {
+  for (uint64_t seed = 1; seed <= 60; ++seed) {
+    RandomPresetLimits two;
+    two.junctions = 2;
+    SimulationOptions o;
+    ASSERT_EQ(DrawRandomOptions(seed, two, &o), "");
+    ASSERT_EQ(o.Check(), "") << seed;
+    RandomPresetLimits none;
+    none.junctions = 0;
+    SimulationOptions p;
+    ASSERT_EQ(DrawRandomOptions(seed, none, &p), "");
+    const double fov_deg =
+        RadToDeg(2.0 * std::atan(0.5 * o.image_width / o.focal_px));
+    EXPECT_GE(fov_deg, 70.0 - 1e-9) << seed;
+    EXPECT_LE(fov_deg, 100.0 + 1e-9) << seed;
+    // The distortion at a pixel radius (here the image's half width).
+    const auto factor = [](const SimulationOptions& x, double r_px) {
+      const double r2 = (r_px / x.focal_px) * (r_px / x.focal_px);
+      return 1.0 + r2 * (x.k1 + r2 * (x.k2 + r2 * x.k3));
+    };
+    EXPECT_NEAR(factor(o, 0.5 * o.image_width), factor(p, 0.5 * p.image_width),
+                1e-12)
+        << seed;
+  }
+}
+
 }  // namespace
 }  // namespace zebrageo::sim
