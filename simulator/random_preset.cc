@@ -206,6 +206,22 @@ void DrawJunctions(uint64_t seed, const RandomPresetLimits& limits,
   o->side_crossing_vehicle_probability = vehicle;
 }
 
+// Crossing designs (issue 52): about one crossing in five of the ladder
+// design (bars 0.2-0.3 m wide), and every crossing's band width and gap
+// drawn within the contract's 0.4-0.6 m and 0.4-0.8 m. Drawn per crossing
+// by the world from its own generator: the other knobs' draws do not
+// change (the crossings' do, with their band counts).
+void DrawCrossingDesigns(SimulationOptions* o) {
+  o->ladder_probability = 0.2;
+  o->min_ladder_bar_width_m = 0.2;
+  o->max_ladder_bar_width_m = 0.3;
+  o->band_sizes_per_crossing = true;
+  o->min_band_width_m = 0.4;
+  o->max_band_width_m = 0.6;
+  o->min_band_gap_m = 0.4;
+  o->max_band_gap_m = 0.8;
+}
+
 void DrawTrajectoryError(std::mt19937_64* rng, const std::string& kind,
                          const RandomPresetLimits& limits,
                          SimulationOptions* o) {
@@ -325,6 +341,7 @@ std::string DrawRandomOptions(uint64_t seed, const RandomPresetLimits& limits,
   DrawTrajectoryError(&rng, o.scenario, limits, &o);
   DrawDatabase(&rng, o.scenario, &o);
   DrawJunctions(seed, limits, &o);
+  DrawCrossingDesigns(&o);
   // Extra crossings only in the database go on the road too.
   const double longest_crossing =
       o.max_band_length_m + o.road_width_m * std::tan(30.0 * kPi / 180.0);
