@@ -22,6 +22,10 @@
 # crossings across them); unset, the random preset draws them (half the
 # surveys). The table bins recall by crossing across the road driven and
 # across a side street.
+# SIM_SET="key=value ..." (issue 52) passes each item to simulate as --set
+# (e.g. SIM_SET="ladder_probability=0.5"; a survey already rendered under
+# WORK is not rendered again: use a fresh WORK); the table bins recall of
+# ladder crossings apart too.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"
@@ -36,6 +40,8 @@ first="${FIRST_SEED:-1}"
 max_length="${MAX_ROAD_LENGTH:-300}"
 threads="${ZEBRAGEO_THREADS:-2}"
 mkdir -p "$work"
+sim_set=()
+for item in ${SIM_SET:-}; do sim_set+=(--set "$item"); done
 scores="$work/scores.jsonl"
 : > "$scores"
 seeds="${SEEDS:-$(seq "$first" $((first + n - 1)))}"
@@ -46,7 +52,7 @@ for seed in $seeds; do
     rm -rf "$survey"
     "$zebrageo" --log-level error simulate --preset random --seed "$seed" \
       --max-road-length "$max_length" ${JUNCTIONS:+--junctions "$JUNCTIONS"} \
-      -o "$survey"
+      "${sim_set[@]}" -o "$survey"
   fi
   rm -rf "$results"
   start=$(date +%s.%N)
