@@ -177,8 +177,10 @@ void PlaceCrossingOnRoad(const Road& road, double s_design,
                        c.band_width_m;
   const double skew_lo = std::min(c.first_offset_m, o_end) * c.tan_skew;
   const double skew_hi = std::max(c.first_offset_m, o_end) * c.tan_skew;
-  // A ladder's bars lie beyond the band ends.
-  const double half = 0.5 * c.band_length_m + c.ladder_bar_width_m;
+  // (A ladder's bars, at most a few decimetres beyond the band ends, stay
+  // within the margins the lines and small marks keep from s_min, s_max:
+  // with them inside, a ladder changes nothing else in the street.)
+  const double half = 0.5 * c.band_length_m;
   c.s_min = c.s_m + std::min(skew_lo, skew_hi) - half;
   c.s_max = c.s_m + std::max(skew_lo, skew_hi) + half;
 }
