@@ -3,6 +3,7 @@
 
   rendered_sweep.py score SURVEY RESULTS EXIT SECONDS   one JSON line on stdout
   rendered_sweep.py table RESULTS.jsonl                 the table and the summary
+  rendered_sweep.py ladder SURVEY RESULTS               issue 52's ladder figures (JSON)
 
 `score` runs ../shared/tools/score_results.py (match, poses, reconstruct) on
 the results folder and adds the reconstruction's recall by range bin (0-11 m,
@@ -67,7 +68,8 @@ def recall_by_range(survey_path, results):
 
 def recall_by_street(survey_path, results):
     """Issue 51's bins: bands of crossings across the road driven ("road")
-    and across a side street ("side", truth/meta.json's "across"). Per bin:
+    and across a side street ("side", truth/meta.json's "across"); issue
+    52's: of the ladder design ("ladder", meta.json's "design"). Per bin:
     bands in full view of >= 2 stereo pairs (exposures) and how many of them
     were reconstructed in at least one; pairs in view and found; the
     vertex errors (metres) of found bands within 10 m."""
@@ -77,10 +79,16 @@ def recall_by_street(survey_path, results):
     s = sr.Survey(survey_path)
     side = {c["crossing_id"] for c in s.meta.get("crossings", [])
             if c.get("across") == "side_street"}
+    ladder = {c["crossing_id"] for c in s.meta.get("crossings", [])
+              if c.get("design") == "ladder" and c["crossing_id"] not in side}
+
+    def bin_of(crossing_id):
+        return ("side" if crossing_id in side else
+                "ladder" if crossing_id in ladder else "road")
     rec = sr.reconstructed(s, results) if os.path.isfile(
         os.path.join(results, "reconstructed_bands.csv")) else {}
     out = {b: {"bands2": 0, "bands2_found": 0, "pairs": 0, "pairs_found": 0, "errs": []}
-           for b in ("road", "side")}
+           for b in ("road", "side", "ladder")}
     found = {}
     for b in rec.values():
         key, dc, errs = sr.nearest_band(s, b["enu"])
@@ -88,19 +96,19 @@ def recall_by_street(survey_path, results):
             continue
         found.setdefault(b["exposure_id"], set()).add(key)
         if b["range"] <= 10.0:
-            out["side" if key[0] in side else "road"]["errs"] += [float(e) for e in errs]
+            out[bin_of(key[0])]["errs"] += [float(e) for e in errs]
     in_view, found_any = {}, set()
     for e in sorted({r["exposure_id"] for r in s.expo}):
         for key in s.visible_pairs(e):
             in_view[key] = in_view.get(key, 0) + 1
-            o = out["side" if key[0] in side else "road"]
+            o = out[bin_of(key[0])]
             o["pairs"] += 1
             if key in found.get(e, set()):
                 o["pairs_found"] += 1
                 found_any.add(key)
     for key, n in in_view.items():
         if n >= 2:
-            o = out["side" if key[0] in side else "road"]
+            o = out[bin_of(key[0])]
             o["bands2"] += 1
             o["bands2_found"] += int(key in found_any)
     return out
@@ -179,7 +187,30 @@ def score(survey, results, exit_code, seconds):
         row["streets"] = recall_by_street(survey, results)
     except Exception as e:
         row["error"] = "%s: %s" % (type(e).__name__, e)
+    row["ladders_gone"] = ladders_gone(survey, results)
     print(json.dumps(row))
+
+
+def ladders_gone(survey, results):
+    """Ladder crossings of the street that report.json calls gone."""
+    meta = json.load(open(os.path.join(survey, "truth", "meta.json")))
+    ladder = {c["crossing_id"] for c in meta.get("crossings", [])
+              if c.get("design") == "ladder" and c.get("in_street")}
+    path = os.path.join(results, "report.json")
+    report = json.load(open(path)) if os.path.isfile(path) else {}
+    return sorted(c.get("crossing_id", "") for c in report.get("crossings_in_view", [])
+                  if c.get("crossing_id") in ladder and "gone" in c.get("status", ""))
+
+
+def ladder(survey, results):
+    """Issue 52: the ladder bin of recall_by_street, with the worst vertex
+    error within 10 m, the false bands and the ladder crossings called gone."""
+    out = recall_by_street(survey, results)["ladder"]
+    out["worst_m"] = max(out["errs"]) if out["errs"] else None
+    out["errs"] = len(out["errs"])
+    out["false_bands"] = recall_by_range(survey, results)[1]
+    out["gone"] = ladders_gone(survey, results)
+    print(json.dumps(out))
 
 
 def spread(values):
@@ -199,8 +230,9 @@ def fmt(x, f="%.1f"):
 def streets_summary(rows):
     """Issue 51: recall and vertex RMSE by crossing across the road driven
     and across a side street."""
-    for b, name in (("road", "across the road driven"), ("side", "across side streets")):
-        st = [r["streets"][b] for r in rows if "streets" in r]
+    for b, name in (("road", "across the road driven"), ("side", "across side streets"),
+                    ("ladder", "of ladder crossings")):
+        st = [r["streets"][b] for r in rows if b in r.get("streets", {})]
         n2 = sum(x["bands2"] for x in st)
         f2 = sum(x["bands2_found"] for x in st)
         pv = sum(x["pairs"] for x in st)
@@ -281,6 +313,8 @@ def table(path):
               sum(r.get("false_gone_faults", 0) for r in rows),
               sum(r.get("occluded", 0) for r in rows),
               sum(r.get("occluded_truck", 0) for r in rows)))
+    print("ladder crossings reported gone from the street: %d" %
+          sum(len(r.get("ladders_gone", [])) for r in rows))
     h_big = sorted(r["h_after"] for r in big)
     fails = []
     if sum(r["wrong"] or 0 for r in rows):
@@ -304,6 +338,9 @@ def table(path):
 def main():
     if len(sys.argv) >= 6 and sys.argv[1] == "score":
         score(*sys.argv[2:6])
+        return 0
+    if len(sys.argv) == 4 and sys.argv[1] == "ladder":
+        ladder(sys.argv[2], sys.argv[3])
         return 0
     if len(sys.argv) == 3 and sys.argv[1] == "table":
         return table(sys.argv[2])

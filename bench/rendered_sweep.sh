@@ -22,9 +22,11 @@
 # crossings across them); unset, the random preset draws them (half the
 # surveys). The table bins recall by crossing across the road driven and
 # across a side street.
-# SIM_SET="key=value ..." (issue 52) passes each as --set to `simulate`
-# (e.g. the paint beside crossings and trucks on them, always on): give
-# the sweep its own WORK, the surveys are kept.
+# SIM_SET="key=value ..." (issue 52) passes each item to simulate as --set
+# (e.g. SIM_SET="ladder_probability=0.5", or the paint beside crossings and
+# trucks on them; a survey already rendered under WORK is not rendered
+# again: give the sweep its own WORK); the table bins recall of ladder
+# crossings apart too.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"

@@ -43,7 +43,24 @@ std::string BandOptions::Check() const {
   OPTION_GT(check, hidden_end_max_offset_m, 0.0);
   OPTION_GE(check, max_length_excess_m, 0.0);
   OPTION_GE(check, min_end_direction_observations, 2);
+  OPTION_GT(check, ladder_gap_reach_m, 0.0);
+  OPTION_IN(check, max_ladder_join_step_fraction, "[", 0.0, 1.0, ")");
+  OPTION_GT(check, ladder_min_bar_width_m, 0.0);
+  OPTION_GT(check, ladder_max_bar_width_m, ladder_min_bar_width_m);
+  OPTION_GE(check, ladder_end_sigma_m, 0.0);
   return check.problem();
+}
+
+const char* EndEvidenceName(EndEvidence evidence) {
+  switch (evidence) {
+    case EndEvidence::kLadderBar:
+      return "ladder_bar";
+    case EndEvidence::kCrossingLine:
+      return "crossing_line";
+    case EndEvidence::kPaintEnd:
+      break;
+  }
+  return "paint_end";
 }
 
 }  // namespace zebrageo

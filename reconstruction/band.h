@@ -144,6 +144,26 @@ struct BandOptions {
   // move apart along the band, one forward, one back.
   bool crossing_end_direction = true;
   int min_end_direction_observations = 4;
+  // Ladder crossings (issue 52): two solid bars along the crossing's edges
+  // join the band ends, so a band end has no edge of its own; the bar's
+  // inner edge, seen in the gaps beside the band (the road brightening into
+  // the bar, the reverse of a band end's polarity), is the end. A band
+  // whose ends are not found as paint ends is modelled again with each end
+  // taken on that edge, searched within ladder_gap_reach_m of its long
+  // sides, when: the edge's step in the gaps is at least
+  // min_end_step_fraction of the long sides' (a bar's paint), the step
+  // across it between the band's corners is at most
+  // max_ladder_join_step_fraction of it (the band runs on into the bar),
+  // and a paint end's polarity (the bar's outer edge) lies
+  // ladder_min_bar_width_m to ladder_max_bar_width_m beyond it. Such an
+  // end's standard deviation along the band adds ladder_end_sigma_m to its
+  // line fit's: the edge is measured beside the band and carried across it.
+  bool ladder_ends = true;
+  double ladder_gap_reach_m = 0.7;
+  double max_ladder_join_step_fraction = 0.3;
+  double ladder_min_bar_width_m = 0.1;
+  double ladder_max_bar_width_m = 0.5;
+  double ladder_end_sigma_m = 0.008;
 
   std::string Check() const;
   template <typename Visitor>
@@ -186,8 +206,20 @@ struct BandOptions {
     v("hidden_end_max_offset_m", hidden_end_max_offset_m);
     v("crossing_end_direction", crossing_end_direction);
     v("min_end_direction_observations", min_end_direction_observations);
+    v("ladder_ends", ladder_ends);
+    v("ladder_gap_reach_m", ladder_gap_reach_m);
+    v("max_ladder_join_step_fraction", max_ladder_join_step_fraction);
+    v("ladder_min_bar_width_m", ladder_min_bar_width_m);
+    v("ladder_max_bar_width_m", ladder_max_bar_width_m);
+    v("ladder_end_sigma_m", ladder_end_sigma_m);
   }
 };
+
+// What placed a band end: its own paint end (an edge across the band),
+// the inner edge of a ladder crossing's bar, or the line of its crossing's
+// other bands' ends (a hidden end).
+enum class EndEvidence { kPaintEnd, kLadderBar, kCrossingLine };
+const char* EndEvidenceName(EndEvidence evidence);
 
 struct Band {
   std::array<Eigen::Vector3d, 4> vertices_body;
@@ -205,6 +237,9 @@ struct Band {
   // 0 (begin) or 1 (end): that transversal side was inferred from the
   // crossing (BandOptions::infer_hidden_ends); -1: both seen.
   int inferred_end = -1;
+  // What placed each end, begin [0] and end [1] (issue 52).
+  std::array<EndEvidence, 2> end_evidence = {EndEvidence::kPaintEnd,
+                                             EndEvidence::kPaintEnd};
 };
 
 // What band modelling tried, for debug images (left rectified pixels).

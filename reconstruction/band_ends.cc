@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace zebrageo {
@@ -41,10 +42,13 @@ void TransversalCandidates(const BandContext& context, const KnownEnd known[2],
   const Area* areas = image.areas;
   for (int e = 0; e < 2; ++e) {
     if (known[e].line != nullptr) continue;
+    // A ladder bar's inner edge has the reverse of a band end's polarity
+    // (the road brightens into the bar beyond the gaps).
+    const double polarity = (e == 0) == !known[e].ladder ? 1.0 : -1.0;
     candidates[e] = HoughTransversalCandidates(
-        context.edges[image.side], areas[e],
-        e == 0 ? image.expected_normal : -image.expected_normal,
-        context.options);
+        context.edges[image.side],
+        known[e].ladder ? image.ladder_areas[e] : areas[e],
+        polarity * image.expected_normal, context.options);
     if (context.debug != nullptr && image.side == 0) {
       context.debug->search_areas.push_back(areas[e]);
       for (const ImageLine& line : candidates[e]) {
@@ -114,6 +118,18 @@ const ImageLine* SeenEndLine(const BandContext& context, const BandSetup& setup,
   return chosen;
 }
 
+// A ladder end: the strongest candidate of the bar's inner edge's polarity
+// (the image darkens into the band along the band direction at its begin);
+// null when none has it.
+const ImageLine* LadderEndLine(const BandImage& image, int e,
+                               const std::vector<ImageLine>& candidates) {
+  const double sign = e == 0 ? 1.0 : -1.0;
+  for (const ImageLine& line : candidates) {
+    if (sign * line.gamma.dot(image.band_direction) < 0.0) return &line;
+  }
+  return nullptr;
+}
+
 // The band's two transversal lines in one image, before refinement: the
 // paper's pair (equations 2 and 3) when both ends are searched, else the
 // known end's line and the seen end's candidate.
@@ -124,7 +140,8 @@ ViewResult ChooseTransversalLines(const BandContext& context, int i,
                                   const std::vector<ImageLine> candidates[2],
                                   ImageLine lines[2]) {
   const int side = image.side;
-  if (known[0].line == nullptr && known[1].line == nullptr) {
+  if (known[0].line == nullptr && known[1].line == nullptr &&
+      !known[0].ladder && !known[1].ladder) {
     int t = -1, l = -1;
     if (!ChooseTransversalPair(candidates[0], candidates[1],
                                image.band_direction, context.options, &t, &l)) {
@@ -143,8 +160,17 @@ ViewResult ChooseTransversalLines(const BandContext& context, int i,
       }
       continue;
     }
+    VLOG(3) << "band " << i << " side " << side << " end " << e << ": "
+            << candidates[e].size() << " candidates"
+            << (candidates[e].empty()
+                    ? std::string()
+                    : ", the first's gamma along the band " +
+                          std::to_string(candidates[e][0].gamma.dot(
+                              image.band_direction)));
     const ImageLine* chosen =
-        SeenEndLine(context, setup, known[e], image, e, candidates[e]);
+        known[e].ladder
+            ? LadderEndLine(image, e, candidates[e])
+            : SeenEndLine(context, setup, known[e], image, e, candidates[e]);
     if (chosen == nullptr) {
       result = ViewResult::kNoTransversal;
     } else {
@@ -171,7 +197,9 @@ ViewResult RefineTransversalLines(const BandContext& context, int i,
   const EdgeMap& edges = context.edges[side];
   for (int e = 0; e < 2; ++e) {
     if (known[e].line != nullptr) continue;
-    if (!RefineImageLine(edges, image.areas[e], options, &lines[e])) {
+    const std::array<Eigen::Vector2d, 4>& area =
+        known[e].ladder ? image.ladder_areas[e] : image.areas[e];
+    if (!RefineImageLine(edges, area, options, &lines[e])) {
       VLOG(2) << "band " << i << " side " << side << " end " << e
               << ": refinement failed";
       return ViewResult::kNoTransversal;
@@ -186,8 +214,7 @@ ViewResult RefineTransversalLines(const BandContext& context, int i,
           std::atan2(Cross2d(normal, own), normal.dot(own));
       VLOG(2) << "band " << i << " side " << side << " end " << e << ": "
               << fits->free_angle[side][e] << " rad from the crossing's ends";
-      if (!RefineImageLine(edges, image.areas[e], options, &lines[e],
-                           &normal)) {
+      if (!RefineImageLine(edges, area, options, &lines[e], &normal)) {
         return ViewResult::kNoTransversal;
       }
     }

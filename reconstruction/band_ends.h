@@ -26,6 +26,9 @@ struct BandSetup {
   // Search areas of the transversal sides (3D corners on the band plane),
   // begin then end.
   std::array<std::array<Eigen::Vector3d, 4>, 2> areas_3d;
+  // The same widened by BandOptions::ladder_gap_reach_m beyond the long
+  // sides: where a ladder bar's inner edge shows in the gaps (issue 52).
+  std::array<std::array<Eigen::Vector3d, 4>, 2> ladder_areas_3d;
   Eigen::Vector3d band_centre;
 };
 
@@ -33,6 +36,7 @@ struct BandSetup {
 struct BandImage {
   int side = 0;                             // 0 left, 1 right
   std::array<Eigen::Vector2d, 4> areas[2];  // search areas, begin and end
+  std::array<Eigen::Vector2d, 4> ladder_areas[2];  // widened (ladder ends)
   // The band direction, and the expected normal of its begin side (the
   // image brightens into the band along the band direction).
   Eigen::Vector2d band_direction, expected_normal;

@@ -54,10 +54,25 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
   const KnownEnd none[2];
   std::vector<BandOutcome> outcomes(m_all);
   std::vector<Band> first(m_all);
+  // A band whose ends are no paint ends may join a ladder's bars (issue
+  // 52): modelled again with both ends taken on the bars' inner edges.
+  std::vector<char> ladder(m_all, 0);
   for (int i = 0; i < m_all; ++i) {
     outcomes[i] = ModelBand(
         context, i, none,
         options.crossing_end_direction ? &observations : nullptr, &first[i]);
+    if (outcomes[i] != BandOutcome::kBand && options.ladder_ends) {
+      KnownEnd bars[2];
+      for (KnownEnd& k : bars) k.ladder = true;
+      Band band;
+      if (ModelBand(context, i, bars,
+                    options.crossing_end_direction ? &observations : nullptr,
+                    &band) == BandOutcome::kBand) {
+        outcomes[i] = BandOutcome::kBand;
+        first[i] = band;
+        ladder[i] = 1;
+      }
+    }
   }
   // 4b. The ends of a crossing's bands are parallel: the direction of its
   // ends, from every band seen in both images and weighted by range, is
@@ -80,7 +95,10 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
     const int c = bands.crossing_of[i];
     if (has_direction[c]) {
       KnownEnd along_crossing[2];
-      for (KnownEnd& k : along_crossing) k.direction = &crossing_direction[c];
+      for (KnownEnd& k : along_crossing) {
+        k.direction = &crossing_direction[c];
+        k.ladder = ladder[i];
+      }
       outcome = ModelBand(context, i, along_crossing, nullptr, &band);
     }
     if (outcome == BandOutcome::kBand) result.push_back(band);

@@ -8,6 +8,7 @@
 
 #include "reconstruction/band_ends.h"
 #include "reconstruction/band_plane.h"
+#include "reconstruction/ladder_ends.h"
 #include "reconstruction/transversal_sides.h"
 
 namespace zebrageo {
@@ -67,6 +68,15 @@ bool SetUpBand(const BandContext& context, int i, BandSetup* setup) {
     for (int k = 0; k < 4; ++k) {
       setup->areas_3d[e][k] = OnBandPlane(frame, plane, corners[k]);
     }
+    const double reach = options.ladder_gap_reach_m;
+    const Eigen::Vector2d wide[4] = {
+        AtLateral(line, along, across, lo.lateral_m - reach, -s),
+        AtLateral(line, along, across, hi.lateral_m + reach, -s),
+        AtLateral(line, along, across, hi.lateral_m + reach, s),
+        AtLateral(line, along, across, lo.lateral_m - reach, s)};
+    for (int k = 0; k < 4; ++k) {
+      setup->ladder_areas_3d[e][k] = OnBandPlane(frame, plane, wide[k]);
+    }
   }
   // The band direction and the expected transversal normal in the image.
   setup->band_centre =
@@ -104,6 +114,17 @@ bool ViewBand(const BandContext& context, int i, const BandSetup& setup,
       // (The valid mask holds for both images: a road point has the
       // same pixel in both.)
       visible = visible && rectification.IsValid(corner.x(), corner.y());
+    }
+  }
+  for (int e = 0; e < 2; ++e) {
+    for (int k = 0; k < 4; ++k) {
+      // Out of view, the gaps beside the band: the band's own area (no
+      // ladder edge is found there).
+      if (!rectification.ProjectToRectified(side, setup.ladder_areas_3d[e][k],
+                                            &image->ladder_areas[e][k])) {
+        image->ladder_areas[e] = areas[e];
+        break;
+      }
     }
   }
   if (!visible) {
@@ -158,7 +179,8 @@ bool EndsStopAtTheLongSides(const BandContext& context, int i,
   const BandCandidate& pair = context.bands.pairs[i];
   bool failed = false;
   for (int e = 0; e < 2 && !failed; ++e) {
-    if (known[e].line != nullptr) continue;
+    // A ladder bar's inner edge runs on into the gaps (ladder_ends.h).
+    if (known[e].line != nullptr || known[e].ladder) continue;
     Eigen::Vector2d ends[2];
     if (!Intersect(long_lines[0], transversal_lines[e], &ends[0]) ||
         !Intersect(long_lines[1], transversal_lines[e], &ends[1])) {
@@ -193,7 +215,7 @@ bool EndsStepLikeThePaint(const BandContext& context, int i,
   const EdgeMap& edges = context.edges[side];
   bool failed = false;
   for (int e = 0; e < 2 && !failed; ++e) {
-    if (known[e].line != nullptr) continue;
+    if (known[e].line != nullptr || known[e].ladder) continue;
     // The long sides' step near this end (a shadow across the band
     // lowers both alike): over 8-32 % of the band from the end.
     double long_step = 0.0;
@@ -262,7 +284,10 @@ ViewResult ModelBandInImage(const BandContext& context, int i,
   if (!EndsStopAtTheLongSides(context, i, known, side, long_lines,
                               transversal_lines) ||
       !EndsStepLikeThePaint(context, i, known, side, long_lines,
-                            transversal_lines, corner)) {
+                            transversal_lines, corner) ||
+      !LadderEndsJoinBars(context, i, known, image, long_lines,
+                          transversal_lines, corner,
+                          views->vertex_side[side])) {
     return ViewResult::kFailed;
   }
   for (int v = 0; v < 4; ++v) {
@@ -307,8 +332,13 @@ void VertexCovariances(const BandContext& context, int i,
     // The two images' lines are independent estimates.
     const double sigma_px = 0.5 * std::hypot(views.ends.line_sigma_px[0][e],
                                              views.ends.line_sigma_px[1][e]);
+    // A ladder end's edge is measured in the gaps beside the band and
+    // carried across it (band.h, ladder_end_sigma_m).
     const double sigma_along =
-        known[e].line != nullptr ? known[e].sigma_m : sigma_px * metres_per_px;
+        known[e].line != nullptr ? known[e].sigma_m
+        : known[e].ladder
+            ? std::hypot(sigma_px * metres_per_px, options.ladder_end_sigma_m)
+            : sigma_px * metres_per_px;
     const bool inferred = pair.inferred == (v == 0 || v == 3 ? 0 : 1);
     const double sigma_across =
         inferred
@@ -488,6 +518,11 @@ BandOutcome FinishBand(const BandContext& context, int i,
   if (!(end_angle <= options.max_end_angle_rad)) {
     VLOG(2) << "band " << i << ": ends " << end_angle << " rad from parallel";
     return BandOutcome::kRejected;
+  }
+  for (int e = 0; e < 2; ++e) {
+    band.end_evidence[e] = known[e].line != nullptr ? EndEvidence::kCrossingLine
+                           : known[e].ladder        ? EndEvidence::kLadderBar
+                                                    : EndEvidence::kPaintEnd;
   }
   VertexCovariances(context, i, known, setup, views, &band);
   ScoreBand(context, i, known, setup, views, &band);

@@ -34,6 +34,9 @@ struct KnownEnd {
   // end is fitted with it (only its offset), once its own direction is
   // found within max_end_angle_rad of it.
   const Eigen::Vector2d* direction = nullptr;
+  // The end is a ladder bar's inner edge (BandOptions::ladder_ends),
+  // searched beside the band with the reverse polarity.
+  bool ladder = false;
 };
 
 // kNoTransversal: no transversal side at an end; kDisagreement: the two

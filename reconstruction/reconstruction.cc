@@ -492,6 +492,8 @@ void AppendPairVertices(const StereoPairReconstructor& reconstructor,
       vertex.uv_left = uv[0][v];
       vertex.uv_right = uv[1][v];
       vertex.score = band.score;
+      vertex.end_evidence =
+          EndEvidenceName(band.end_evidence[v == 0 || v == 1 ? 0 : 1]);
       vertices->push_back(vertex);
     }
   }

@@ -122,7 +122,8 @@ void ImageScene::AddItems() {
     if (crossing.s_max < s_lo_ || crossing.s_min > s_hi_) continue;
     Eigen::AlignedBox2d box;
     for (int b = 0; b < crossing.num_street_bands; ++b) {
-      box.extend(box_of(world_.bands[first_band_[c] + b].corners, 0.3));
+      box.extend(box_of(world_.bands[first_band_[c] + b].corners,
+                        0.3 + crossing.ladder_bar_width_m));
     }
     items.push_back({(kItemCrossing << 24) | c, box});
   }

@@ -108,6 +108,9 @@ class ImageScene {
   void ShadeBandPaint(const Eigen::Vector3d& d, double t_box, double footprint,
                       int index, Eigen::Vector3d* p, float* value,
                       uint32_t* key) const;
+  void ShadeLadderBar(const Eigen::Vector3d& d, double t_box, double footprint,
+                      int index, int nearest, Eigen::Vector3d* p, float* value,
+                      uint32_t* key) const;
   Sample ShadeBox(const Eigen::Vector3d& d, const BoxHit& hit) const;
   Sample ShadeSky(const Eigen::Vector3d& d) const;
   float Fog(float value, double t) const;

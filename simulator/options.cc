@@ -85,6 +85,21 @@ void CheckStreetRanges(const SimulationOptions& o, Checker* c) {
            o.min_bands_per_crossing, 40);
   c->Range("band_width_m", o.band_width_m, 0.2, 1.0);
   c->Range("band_gap_m", o.band_gap_m, 0.2, 1.5);
+  c->Range("ladder_probability", o.ladder_probability, 0.0, 1.0);
+  c->Range("min_ladder_bar_width_m", o.min_ladder_bar_width_m, 0.05, 1.0);
+  c->Range("max_ladder_bar_width_m", o.max_ladder_bar_width_m,
+           o.min_ladder_bar_width_m, 1.0);
+  c->Range("min_band_width_m", o.min_band_width_m, 0.2, 1.0);
+  c->Range("max_band_width_m", o.max_band_width_m, o.min_band_width_m, 1.0);
+  c->Range("min_band_gap_m", o.min_band_gap_m, 0.2, 1.5);
+  c->Range("max_band_gap_m", o.max_band_gap_m, o.min_band_gap_m, 1.5);
+  if (o.band_sizes_per_crossing) {
+    c->Require(o.road_width_m - 0.5 + o.max_band_gap_m >=
+                   2.0 * (o.max_band_width_m + o.max_band_gap_m),
+               "road_width_m = " + Fmt(o.road_width_m) +
+                   ": must fit at least 2 bands of max_band_width_m + "
+                   "max_band_gap_m");
+  }
   c->Range("min_band_length_m", o.min_band_length_m, 1.0, 10.0);
   c->Range("max_band_length_m", o.max_band_length_m, o.min_band_length_m, 10.0);
   c->Range("skew_probability", o.skew_probability, 0.0, 1.0);

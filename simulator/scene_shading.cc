@@ -274,6 +274,39 @@ void ImageScene::ShadeBandPaint(const Eigen::Vector3d& d, double t_box,
     *p = q;
     return;
   }
+  if (c.ladder_bar_width_m > 0.0) {
+    ShadeLadderBar(d, t_box, footprint, index, nearest, p, value, key);
+  }
+}
+
+// The paint of crossing `index`'s ladder bars (issue 52) near *p, on the
+// plane of the band nearest (`nearest`, clamped): the bars lie on the road
+// between the bands' planes, within a millimetre of either.
+void ImageScene::ShadeLadderBar(const Eigen::Vector3d& d, double t_box,
+                                double footprint, int index, int nearest,
+                                Eigen::Vector3d* p, float* value,
+                                uint32_t* key) const {
+  const Crossing& c = world_.crossings[index];
+  const int b = std::clamp(nearest, 1, c.num_street_bands);
+  const Band& band = world_.bands[first_band_[index] + b - 1];
+  const double denominator = band.plane_normal.dot(d);
+  if (std::abs(denominator) < 1e-9) return;
+  const double tp =
+      (band.plane_offset - band.plane_normal.dot(C_)) / denominator;
+  if (tp <= 0.0 || tp >= t_box) return;
+  const Eigen::Vector3d q = C_ + tp * d;
+  const Eigen::Vector2d rq = q.head<2>() - c.origin_xy;
+  const double oq = rq.dot(c.n);
+  const double aq = rq.dot(c.t) - oq * c.tan_skew;
+  if (!InLadderBar(c, oq, aq)) return;
+  const float alpha = PaintAlpha(q.x(), q.y(), world_.paint_wear, c.salt);
+  const float under = kAsphaltTone * AsphaltTexture(q.x(), q.y(), footprint,
+                                                    world_.texture_salt);
+  *value = under * (1.0f - alpha) +
+           alpha * PaintTone(q.x(), q.y(), footprint, c.salt);
+  // One key per bar and band slot: the supersampling sees its edges.
+  *key = Key(kBandPaint, first_band_[index] + b - 1);
+  *p = q;
 }
 
 Sample ImageScene::ShadeGround(const Eigen::Vector3d& d, double t,

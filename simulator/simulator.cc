@@ -110,6 +110,10 @@ nlohmann::json CrossingJson(const World& world, const sim::Crossing& c) {
   j["band_length_m"] = c.band_length_m;
   j["band_width_m"] = c.band_width_m;
   j["band_period_m"] = c.band_period_m;
+  // Issue 52: the design, and the ladder's bars (not in the database).
+  j["design"] = c.ladder_bar_width_m > 0.0 ? "ladder" : "continental";
+  if (c.ladder_bar_width_m > 0.0)
+    j["ladder_bar_width_m"] = c.ladder_bar_width_m;
   j["s_m"] = c.s_m;
   const Eigen::Vector3d centre = world.road.SurfacePoint(c.s_m, 0.0);
   j["origin_enu"] = {c.origin_xy.x(), c.origin_xy.y(), centre.z()};

@@ -92,6 +92,24 @@ struct SimulationOptions {
   // their sum, ~1 m: the matching ambiguity).
   double band_width_m = 0.5;
   double band_gap_m = 0.5;
+  // Crossing designs and band sizes (issue 52). The ladder design: two
+  // solid bars along the crossing's two edges (the lines its band ends lie
+  // on) join the band ends, as in much of the UK and the US; drawn per
+  // crossing of the road driven with ladder_probability. Each bar's width
+  // along the road is drawn per crossing in [min, max]: 0.2-0.3 m, the
+  // 8-12 inch lines the MUTCD (3B.18, 6-24 inches allowed) and most US
+  // cities paint. The database holds the bands only (SURVEY_FORMAT.md).
+  double ladder_probability = 0.0;
+  double min_ladder_bar_width_m = 0.2;
+  double max_ladder_bar_width_m = 0.3;
+  // True: each crossing's band width and gap are drawn in [min, max] (the
+  // same within a crossing; SURVEY_FORMAT.md: bands 0.4-0.6 m wide, gaps
+  // 0.4-0.8 m) instead of band_width_m and band_gap_m.
+  bool band_sizes_per_crossing = false;
+  double min_band_width_m = 0.4;
+  double max_band_width_m = 0.6;
+  double min_band_gap_m = 0.4;
+  double max_band_gap_m = 0.8;
   // Band length along the road, drawn per crossing.
   double min_band_length_m = 2.5;
   double max_band_length_m = 6.0;

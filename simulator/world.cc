@@ -17,7 +17,9 @@ namespace zebrageo::sim {
 
 using world_internal::BuildFacades;
 using world_internal::CastShadows;
+using world_internal::CrossingDesignDraw;
 using world_internal::DrawBandRow;
+using world_internal::DrawCrossingDesign;
 using world_internal::kBandKerbMarginM;
 using world_internal::kCrossingSeed;
 using world_internal::kDatabaseSeed;
@@ -90,8 +92,8 @@ std::vector<std::string> CrossingRoles(const SimulationOptions& options,
 // bands' place across the road, and the database's offset. `fit` bands of
 // `period` fit between the kerbs.
 Crossing DesignCrossing(const SimulationOptions& options, const Road& road,
-                        double s_design, double period, int fit,
-                        std::mt19937_64* rng) {
+                        double s_design, const CrossingDesignDraw& design,
+                        int fit, std::mt19937_64* rng) {
   Crossing c;
   c.t = road.Tangent(s_design);
   c.n = road.LeftNormal(s_design);
@@ -103,8 +105,9 @@ Crossing DesignCrossing(const SimulationOptions& options, const Road& road,
   c.tan_skew = std::tan(DegToRad(c.skew_deg));
   c.band_length_m =
       Uniform(rng, options.min_band_length_m, options.max_band_length_m);
-  c.band_width_m = options.band_width_m;
-  c.band_period_m = period;
+  c.band_width_m = design.band_width_m;
+  c.band_period_m = design.band_width_m + design.band_gap_m;
+  c.ladder_bar_width_m = design.ladder_bar_width_m;
   const int most = std::min(options.max_bands_per_crossing, fit);
   DrawBandRow(options, road.width_m(), most, rng, &c);
   return c;
@@ -174,8 +177,12 @@ void PlaceCrossingOnRoad(const Road& road, double s_design,
                        c.band_width_m;
   const double skew_lo = std::min(c.first_offset_m, o_end) * c.tan_skew;
   const double skew_hi = std::max(c.first_offset_m, o_end) * c.tan_skew;
-  c.s_min = c.s_m + std::min(skew_lo, skew_hi) - 0.5 * c.band_length_m;
-  c.s_max = c.s_m + std::max(skew_lo, skew_hi) + 0.5 * c.band_length_m;
+  // (A ladder's bars, at most a few decimetres beyond the band ends, stay
+  // within the margins the lines and small marks keep from s_min, s_max:
+  // with them inside, a ladder changes nothing else in the street.)
+  const double half = 0.5 * c.band_length_m;
+  c.s_min = c.s_m + std::min(skew_lo, skew_hi) - half;
+  c.s_max = c.s_m + std::max(skew_lo, skew_hi) + half;
 }
 
 void PlaceCrossings(const SimulationOptions& options, World* world) {
@@ -189,16 +196,19 @@ void PlaceCrossings(const SimulationOptions& options, World* world) {
   // The database's band gaps draw from their own generator: the crossings
   // of the other presets do not change with these knobs.
   std::mt19937_64 gap_rng(SubSeed(options.seed, kCrossingSeed, 7));
+  // So do the designs (band sizes, ladder bars; issue 52).
+  std::mt19937_64 design_rng(SubSeed(options.seed, kCrossingSeed, 52));
 
   const double width = road.width_m();
-  const double period = options.band_width_m + options.band_gap_m;
-  const int fit = static_cast<int>(std::floor(
-      (width - 2.0 * kBandKerbMarginM + options.band_gap_m) / period));
   int number = 100 + UniformInt(&rng, 1, 20);
   for (int i = 0; i < total; ++i) {
     number += UniformInt(&rng, 1, 3);  // ids are labels, with gaps
     const double s_design = positions[i];
-    Crossing c = DesignCrossing(options, road, s_design, period, fit, &rng);
+    const CrossingDesignDraw design = DrawCrossingDesign(options, &design_rng);
+    const int fit = static_cast<int>(
+        std::floor((width - 2.0 * kBandKerbMarginM + design.band_gap_m) /
+                   (design.band_width_m + design.band_gap_m)));
+    Crossing c = DesignCrossing(options, road, s_design, design, fit, &rng);
     c.id = CrossingId(number);
     c.salt = SubSeed(options.seed, kCrossingSeed, 1000 + i);
     const RoleDraws draws = DrawRoleDraws(options, &rng);
@@ -399,8 +409,9 @@ void DrawBandRow(const SimulationOptions& options, double width, int most,
   const int least = std::min(options.min_bands_per_crossing, most);
   c->num_design_bands =
       Bernoulli(rng, 0.6) ? most : UniformInt(rng, least, most);
-  const double span = c->num_design_bands * c->band_width_m +
-                      (c->num_design_bands - 1) * options.band_gap_m;
+  const double gap = c->band_period_m - c->band_width_m;
+  const double span =
+      c->num_design_bands * c->band_width_m + (c->num_design_bands - 1) * gap;
   const double free = width - 2.0 * kBandKerbMarginM - span;
   c->first_offset_m = -0.5 * width + kBandKerbMarginM +
                       (free > 0.3 ? Uniform(rng, 0.0, free) : 0.5 * free);

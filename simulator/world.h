@@ -98,6 +98,10 @@ struct Crossing {
   double band_length_m = 3.0;
   double band_width_m = 0.5;
   double band_period_m = 1.0;  // width + gap
+  // The ladder design (issue 52): > 0 when two solid bars this wide (along
+  // t) lie along the crossing's edges, just beyond its band ends, from the
+  // first band's outer long side to the last one's (world_ladder.cc).
+  double ladder_bar_width_m = 0.0;
   int num_design_bands = 0;
   double first_offset_m = 0.0;
   std::vector<int> ring_start;  // per design band, 0..3
@@ -274,6 +278,10 @@ double GroundHeight(const World& world, const Eigen::Vector2d& xy, double s,
 std::array<Eigen::Vector3d, 4> DesignBandCorners(
     const World& world, const Crossing& crossing, int band,
     const Eigen::Vector2d& origin_xy);
+
+// True when crossing-frame point (o, a) (a measured from the skew line, as
+// for the bands) lies on one of the crossing's ladder bars.
+bool InLadderBar(const Crossing& crossing, double o, double a);
 
 // Truth: the bands painted in the street and the lines, exact.
 RoadmarkDatabase MakeTruthRoadmarks(const World& world,

@@ -50,6 +50,18 @@ bool NearCrossing(const World& world, double s0, double s1, double margin);
 void DrawBandRow(const SimulationOptions& options, double width, int most,
                  std::mt19937_64* rng, Crossing* c);
 
+// A crossing's design (world_ladder.cc, issue 52): its band width and gap
+// and its ladder bars' width (0: none).
+struct CrossingDesignDraw {
+  double band_width_m = 0.5;
+  double band_gap_m = 0.5;
+  double ladder_bar_width_m = 0.0;
+};
+// Drawn from `rng` for every crossing whatever the options (the same number
+// of draws), so the other crossings' draws do not change with them.
+CrossingDesignDraw DrawCrossingDesign(const SimulationOptions& options,
+                                      std::mt19937_64* rng);
+
 void PlaceJunctions(const SimulationOptions& options, World* world);
 // Buildings cut back from the side streets' mouths (world_junctions.cc).
 void OpenFacadesAtJunctions(const SimulationOptions& options, World* world);

@@ -126,7 +126,9 @@ void WriteReconstructedBands(const std::vector<ReconstructedVertex>& vertices,
   AtomicFile file(path);
   CsvWriter csv(&file.stream());
   WriteComments(&csv, comments);
-  csv.Header(ReconstructedColumns());
+  std::vector<std::string> columns = ReconstructedColumns();
+  columns.push_back("end_evidence");  // extra trailing column (issue 52)
+  csv.Header(columns);
   for (const ReconstructedVertex& v : vertices) {
     const Eigen::Matrix3d& c = v.covariance_body;
     csv.Add(v.exposure_id)
@@ -147,7 +149,8 @@ void WriteReconstructedBands(const std::vector<ReconstructedVertex>& vertices,
         .Add(v.uv_left.y())
         .Add(v.uv_right.x())
         .Add(v.uv_right.y())
-        .Add(v.score);
+        .Add(v.score)
+        .Add(v.end_evidence);
     csv.EndRow();
   }
   file.Commit();
@@ -183,6 +186,9 @@ std::vector<ReconstructedVertex> ReadReconstructedBands(
     v.uv_right = Eigen::Vector2d(csv.GetDouble(row, "u_right"),
                                  csv.GetDouble(row, "v_right"));
     v.score = csv.GetDouble(row, "score");
+    if (csv.HasColumn("end_evidence")) {
+      v.end_evidence = csv.GetString(row, "end_evidence");
+    }
     if (v.score < 0.0 || v.score > 1.0) {
       csv.Fail(row, "column 'score': " + FormatDouble(v.score) +
                         " is outside [0, 1]");

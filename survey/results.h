@@ -43,6 +43,10 @@ struct ReconstructedVertex {
   Eigen::Vector2d uv_left = Eigen::Vector2d::Zero();  // distorted image px
   Eigen::Vector2d uv_right = Eigen::Vector2d::Zero();
   double score = 0.0;  // 0..1
+  // What placed the vertex's end of the band (issue 52; an extra trailing
+  // column): "paint_end" (its own edge), "ladder_bar" (a ladder bar's inner
+  // edge) or "crossing_line" (the line of its crossing's other ends).
+  std::string end_evidence = "paint_end";
 };
 void WriteReconstructedBands(const std::vector<ReconstructedVertex>& vertices,
                              const std::vector<std::string>& comments,
