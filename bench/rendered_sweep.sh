@@ -21,7 +21,8 @@
 # JUNCTIONS=N (issue 51) gives every survey N junctions (side streets with
 # crossings across them); unset, the random preset draws them (half the
 # surveys). The table bins recall by crossing across the road driven and
-# across a side street.
+# across a side street. AVENUES=1 (issue 52) makes every survey an avenue
+# (AVENUES=0 none; unset, one survey in five).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"
@@ -46,6 +47,7 @@ for seed in $seeds; do
     rm -rf "$survey"
     "$zebrageo" --log-level error simulate --preset random --seed "$seed" \
       --max-road-length "$max_length" ${JUNCTIONS:+--junctions "$JUNCTIONS"} \
+      ${AVENUES:+--avenues "$AVENUES"} \
       -o "$survey"
   fi
   rm -rf "$results"
