@@ -61,7 +61,7 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
   sub->add_option("--avenues", args->avenues,
                   "random preset: 1 an avenue (median, refuge islands "
                   "splitting the crossings, lanes; issue 52), 0 none, -1 "
-                  "drawn (one survey in five)")
+                  "drawn (one survey in five); default none")
       ->capture_default_str()
       ->check(CLI::Range(-1, 1));
   sub->add_flag("--no-images", args->no_images,

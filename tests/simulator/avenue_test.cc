@@ -154,6 +154,7 @@ TEST(Avenue, RandomPresetDrawsThemInAShareOfSurveysOnly) {
   for (uint64_t seed = 1; seed <= 200; ++seed) {
     SimulationOptions drawn, none, every;
     RandomPresetLimits limits;
+    limits.avenues = -1;
     ASSERT_EQ(DrawRandomOptions(seed, limits, &drawn), "") << seed;
     limits.avenues = 0;
     ASSERT_EQ(DrawRandomOptions(seed, limits, &none), "") << seed;

@@ -43,8 +43,8 @@ struct GeometrySweepOptions {
   // drawn, 0 none, N exactly N per survey.
   int junctions = -1;
   // Avenues of the random preset (RandomPresetLimits::avenues, issue 52):
-  // -1 drawn, 0 none, 1 every survey.
-  int avenues = -1;
+  // -1 drawn, 0 none (the default), 1 every survey.
+  int avenues = 0;
   // Only surveys of this random kind (simulator.h: RandomKinds()); empty:
   // all.
   std::string only_kind;
