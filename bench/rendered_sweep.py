@@ -106,6 +106,40 @@ def recall_by_street(survey_path, results):
     return out
 
 
+def faults_against_truth(survey, results):
+    """Issue 52: the database faults that say paint is gone (a crossing
+    gone from the street, a band missing from it) counted against the
+    simulator's truth: "false" where the street has the paint. Also the
+    crossings and bands reported occluded, and those of them under a truck
+    (truth/meta.json's truck_bands)."""
+    sys.path.insert(0, TOOLS)
+    import score_results as sr
+    s = sr.Survey(survey)
+    painted = set(s.keys)
+    crossings = {k[0] for k in painted}
+    path = os.path.join(results, "match_evidence.json")
+    evidence = json.load(open(path)) if os.path.isfile(path) else {}
+    out = {"gone_faults": 0, "false_gone_faults": 0, "occluded": 0,
+           "occluded_truck": 0}
+    for f in evidence.get("faults", []):
+        if f.get("kind") == "crossing_gone_from_street":
+            out["gone_faults"] += 1
+            out["false_gone_faults"] += int(f.get("crossing_id") in crossings)
+        elif f.get("kind") == "band_missing_from_street":
+            out["gone_faults"] += 1
+            out["false_gone_faults"] += int((f.get("crossing_id"), f.get("band")) in painted)
+    truck = {(c["crossing_id"], b) for c in s.meta.get("crossings", [])
+             for b in c.get("truck_bands", [])}
+    for m in evidence.get("not_recognised", []):
+        if m.get("why") != "occluded":
+            continue
+        out["occluded"] += 1
+        out["occluded_truck"] += int((m.get("crossing_id"), m.get("band")) in truck or
+                                     (m.get("band") is None and
+                                      any(t[0] == m.get("crossing_id") for t in truck)))
+    return out
+
+
 def score(survey, results, exit_code, seconds):
     row = {"survey": os.path.basename(os.path.normpath(survey)), "exit": int(exit_code),
            "seconds": float(seconds)}
@@ -137,6 +171,10 @@ def score(survey, results, exit_code, seconds):
     row["visible_far"], row["found_far"] = seen["far"]
     row["false_bands"] = false
     row["crossings_in_street"] = crossings
+    try:
+        row.update(faults_against_truth(survey, results))
+    except Exception as e:
+        row["error"] = "%s: %s" % (type(e).__name__, e)
     try:
         row["streets"] = recall_by_street(survey, results)
     except Exception as e:
@@ -237,6 +275,12 @@ def table(path):
         "%.1f%% (%d/%d)" % (100.0 * far[1] / far[0], far[1], far[0]) if far[0] else "-",
         sum(r["false_bands"] for r in rows)))
     streets_summary(rows)
+    print("faults saying paint is gone: %d, of them where the street has the paint %d; "
+          "reported occluded %d (under a truck %d)" % (
+              sum(r.get("gone_faults", 0) for r in rows),
+              sum(r.get("false_gone_faults", 0) for r in rows),
+              sum(r.get("occluded", 0) for r in rows),
+              sum(r.get("occluded_truck", 0) for r in rows)))
     h_big = sorted(r["h_after"] for r in big)
     fails = []
     if sum(r["wrong"] or 0 for r in rows):

@@ -21,8 +21,12 @@
 # JUNCTIONS=N (issue 51) gives every survey N junctions (side streets with
 # crossings across them); unset, the random preset draws them (half the
 # surveys). The table bins recall by crossing across the road driven and
-# across a side street. AVENUES=1 (issue 52) makes every survey an avenue
-# (AVENUES=0 none; unset, one survey in five).
+# across a side street.
+# SIM_SET="key=value ..." (issue 52) passes each as --set to `simulate`
+# (e.g. the paint beside crossings and trucks on them, always on): give
+# the sweep its own WORK, the surveys are kept.
+# AVENUES=1 (issue 52) makes every survey an avenue (AVENUES=-1 one
+# in five; unset or 0, none).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"
@@ -37,6 +41,8 @@ first="${FIRST_SEED:-1}"
 max_length="${MAX_ROAD_LENGTH:-300}"
 threads="${ZEBRAGEO_THREADS:-2}"
 mkdir -p "$work"
+sim_set=()
+for item in ${SIM_SET:-}; do sim_set+=(--set "$item"); done
 scores="$work/scores.jsonl"
 : > "$scores"
 seeds="${SEEDS:-$(seq "$first" $((first + n - 1)))}"
@@ -48,7 +54,7 @@ for seed in $seeds; do
     "$zebrageo" --log-level error simulate --preset random --seed "$seed" \
       --max-road-length "$max_length" ${JUNCTIONS:+--junctions "$JUNCTIONS"} \
       ${AVENUES:+--avenues "$AVENUES"} \
-      -o "$survey"
+      "${sim_set[@]}" -o "$survey"
   fi
   rm -rf "$results"
   start=$(date +%s.%N)

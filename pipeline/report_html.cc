@@ -365,7 +365,7 @@ std::string RenderHtml(const json& report, const ReportData& data) {
   html << "<h2>Crossings</h2>\n" << ArrayTable(report["crossings"]);
   html << "<h2>Database crossings in view</h2>\n"
        << "<p>What became of each: matched, refused, gone from the street, "
-          "not recognised, or not reconstructed and why.</p>\n"
+          "occluded, not recognised, or not reconstructed and why.</p>\n"
        << ArrayTable(report.value("crossings_in_view", json::array()));
   html << "<p>Observations not matched, by reason:</p>\n"
        << ArrayTable(report["unmatched_reasons"]);

@@ -136,6 +136,7 @@ void AddMissingBands(const MatchState& state, const Obs& obs,
             obs.source->exposure_id, pose, index.bands()[b].corners_enu, seen);
         if (evidence == PaintEvidence::kPaint) eval->painted.push_back(b);
         if (evidence == PaintEvidence::kUnknown) eval->unclear.push_back(b);
+        if (evidence == PaintEvidence::kOccluded) eval->occluded.push_back(b);
         if (evidence != PaintEvidence::kBareRoad) continue;
       }
       eval->missing.push_back(b);

@@ -38,8 +38,15 @@ std::string ExposureList(const std::vector<int64_t>& exposures) {
 // Per database band (or crossing): the views whose images show bare road
 // at its place, paint there, or neither.
 struct ImageVerdicts {
-  std::vector<int64_t> bare, paint, unclear;
+  std::vector<int64_t> bare, paint, unclear, occluded;
 };
+
+// A band's place: bare road in enough views, paint in none and nothing
+// standing over it in any: the only evidence a band fault may rest on.
+bool ShowsBareRoad(const ImageVerdicts& v, int min_views) {
+  return static_cast<int>(v.bare.size()) >= min_views && v.paint.empty() &&
+         v.occluded.empty();
+}
 
 // The mark for a band or crossing the images did not show gone.
 UnrecognisedMark Unrecognised(const std::string& crossing_id, int band,
@@ -53,6 +60,7 @@ UnrecognisedMark Unrecognised(const std::string& crossing_id, int band,
   std::vector<int64_t> all = verdicts.bare;
   all.insert(all.end(), verdicts.paint.begin(), verdicts.paint.end());
   all.insert(all.end(), verdicts.unclear.begin(), verdicts.unclear.end());
+  all.insert(all.end(), verdicts.occluded.begin(), verdicts.occluded.end());
   std::sort(all.begin(), all.end());
   all.erase(std::unique(all.begin(), all.end()), all.end());
   mark.exposure_ids = all;
@@ -64,6 +72,15 @@ UnrecognisedMark Unrecognised(const std::string& crossing_id, int band,
                        " views that should have shown it; without the "
                        "images nothing tells whether it is gone: not a "
                        "database fault";
+  } else if (!verdicts.occluded.empty() && verdicts.paint.empty()) {
+    mark.why = "occluded";
+    mark.description =
+        what +
+        " was not recognised: the stereo pair shows something "
+        "standing above the road at its place (" +
+        ExposureList(verdicts.occluded) +
+        ": its image points match in front of the road surface, not on "
+        "it): occluded, not a database fault";
   } else if (!verdicts.paint.empty()) {
     mark.why = "paint seen";
     mark.description = what +
@@ -143,6 +160,9 @@ void DetectBandFaults(MatchState* state) {
     for (int b : h.eval.unclear) {
       if (!index.bands()[b].implied) verdicts[b].unclear.push_back(exposure);
     }
+    for (int b : h.eval.occluded) {
+      if (!index.bands()[b].implied) verdicts[b].occluded.push_back(exposure);
+    }
     if (h.main_crossing < 0) continue;
     const IndexedCrossing& crossing = crossings[h.main_crossing];
     const Eigen::Vector2d first = crossing.ToCrossing(crossing.first_end_enu);
@@ -167,7 +187,7 @@ void DetectBandFaults(MatchState* state) {
     const std::string what = "database band " + std::to_string(band.band) +
                              " of crossing " + band.crossing_id;
     const int bare = static_cast<int>(v.bare.size());
-    if (probed && bare >= options.min_views_for_fault && v.paint.empty()) {
+    if (probed && ShowsBareRoad(v, options.min_views_for_fault)) {
       DatabaseFault fault;
       fault.kind = FaultKind::kBandMissingFromStreet;
       fault.crossing_id = band.crossing_id;
@@ -187,8 +207,8 @@ void DetectBandFaults(MatchState* state) {
       state->faults.push_back(fault);
       continue;
     }
-    const int views =
-        static_cast<int>(v.bare.size() + v.paint.size() + v.unclear.size());
+    const int views = static_cast<int>(v.bare.size() + v.paint.size() +
+                                       v.unclear.size() + v.occluded.size());
     if (views < options.min_views_for_fault) continue;
     state->unrecognised.push_back(Unrecognised(
         band.crossing_id, band.band, band.centre_enu, v, probed, what));
@@ -316,19 +336,23 @@ void DetectCrossingsGoneFromStreet(MatchState* state) {
       should_have_seen[crossing].push_back(exposure.exposure_id);
       if (!probed) continue;
       // This view's verdict: paint on any band, bare road on at least
-      // three (or all) and paint on none, or neither.
-      int bare = 0, paint = 0;
+      // three (or all; a band under something standing over it is never
+      // bare road), something standing over any, or neither.
+      int bare = 0, paint = 0, occluded = 0;
       for (int b : visible) {
         const PaintEvidence e = input.paint_probe(
             exposure.exposure_id, pose, index.bands()[b].corners_enu, {});
         bare += e == PaintEvidence::kBareRoad;
         paint += e == PaintEvidence::kPaint;
+        occluded += e == PaintEvidence::kOccluded;
       }
       ImageVerdicts& v = verdicts[crossing];
       if (paint > 0) {
         v.paint.push_back(exposure.exposure_id);
       } else if (bare >= std::min<int>(3, static_cast<int>(x.bands.size()))) {
         v.bare.push_back(exposure.exposure_id);
+      } else if (occluded > 0) {
+        v.occluded.push_back(exposure.exposure_id);
       } else {
         v.unclear.push_back(exposure.exposure_id);
       }
@@ -405,7 +429,11 @@ void ListCrossingsInView(MatchState* state) {
   }
   for (const UnrecognisedMark& m : state->unrecognised) {
     if (m.band != 0 || fate.count(by_id[m.crossing_id])) continue;
-    fate[by_id[m.crossing_id]] = {"not recognised", m.why};
+    // Occluded: the stereo pair shows something standing over it (issue
+    // 51 point 4, issue 52), listed as such rather than "not recognised".
+    fate[by_id[m.crossing_id]] = {
+        m.why == "occluded" ? "occluded" : "not recognised",
+        m.why == "occluded" ? m.description : m.why};
   }
   // Views with a band in full view, the nearest distance, and whether its
   // bands lay across the track there (long sides along the baseline).

@@ -134,6 +134,8 @@ struct Eval {
   // no evidence against the hypothesis, and no database fault (issue 52).
   std::vector<int> painted;
   std::vector<int> unclear;
+  // Where the stereo pair shows something standing above the road.
+  std::vector<int> occluded;
   double score = 0.0;
 
   // The crossing most hits fall on, or -1.

@@ -53,6 +53,8 @@ const char* PaintEvidenceName(PaintEvidence evidence) {
       return "paint";
     case PaintEvidence::kBareRoad:
       return "bare road";
+    case PaintEvidence::kOccluded:
+      return "occluded";
     case PaintEvidence::kUnknown:
       break;
   }
@@ -68,7 +70,16 @@ std::string PaintProbeOptions::Check() const {
   OPTION_LE(check, paint_level, 1.0);
   OPTION_GT(check, max_bare_spread, 0.0);
   OPTION_IN(check, min_inside_share, "(", 0.0, 1.0, "]");
-  OPTION_GE(check, cached_images, 1);
+  OPTION_GE(check, cached_images, 2);
+  OPTION_GE(check, occlusion_window_px, 3);
+  check.Require(occlusion_window_px % 2 == 1, "occlusion_window_px",
+                occlusion_window_px, "must be odd");
+  OPTION_GT(check, occlusion_min_height_m, 0.0);
+  OPTION_GE(check, occlusion_min_texture, 0.0);
+  OPTION_IN(check, occlusion_min_ncc, "(", 0.0, 1.0, "]");
+  OPTION_GE(check, occlusion_ncc_margin, 0.0);
+  OPTION_GE(check, occlusion_min_points, 1);
+  OPTION_IN(check, occlusion_min_share, "(", 0.0, 1.0, "]");
   OPTION_GT(check, assumed_paint_contrast, 0.0);
   OPTION_GT(check, max_road_level_change, 0.0);
   return check.problem();
@@ -79,35 +90,47 @@ ImagePaintProbe::ImagePaintProbe(const Survey& survey,
     : survey_(survey), options_(options) {
   if (survey.rig.stereo_pairs.empty()) return;
   camera_ = survey.rig.stereo_pairs.front()[0];
+  right_camera_ = survey.rig.stereo_pairs.front()[1];
   for (const Exposure& e : survey.exposures.exposures) {
-    if (camera_ >= static_cast<int>(e.image_of_camera.size())) continue;
-    const int image = e.image_of_camera[camera_];
-    if (image >= 0) {
-      image_of_exposure_[e.exposure_id] = survey.exposures.images[image].image;
+    for (int side = 0; side < 2; ++side) {
+      const int camera = side == 0 ? camera_ : right_camera_;
+      if (camera >= static_cast<int>(e.image_of_camera.size())) continue;
+      const int image = e.image_of_camera[camera];
+      if (image < 0) continue;
+      (side == 0 ? image_of_exposure_
+                 : right_image_of_exposure_)[e.exposure_id] =
+          survey.exposures.images[image].image;
     }
   }
 }
 
 const cv::Mat* ImagePaintProbe::LeftImage(int64_t exposure_id) {
+  return CameraImage(exposure_id, camera_);
+}
+
+const cv::Mat* ImagePaintProbe::CameraImage(int64_t exposure_id, int camera) {
+  const int side = camera == camera_ ? 0 : 1;
+  const int64_t key = exposure_id * 2 + side;
   for (auto it = cache_.begin(); it != cache_.end(); ++it) {
-    if (it->first != exposure_id) continue;
+    if (it->first != key) continue;
     cache_.splice(cache_.begin(), cache_, it);
-    return &cache_.front().second;
+    return cache_.front().second.empty() ? nullptr : &cache_.front().second;
   }
-  const auto path = image_of_exposure_.find(exposure_id);
-  if (path == image_of_exposure_.end()) return nullptr;
+  const auto& paths = side == 0 ? image_of_exposure_ : right_image_of_exposure_;
+  const auto path = paths.find(exposure_id);
+  if (path == paths.end()) return nullptr;
   cv::Mat image;
   try {
-    const Camera& camera = survey_.rig.cameras[camera_].camera;
+    const Camera& model = survey_.rig.cameras[camera].camera;
     image = ReadGrayImage(survey_.PathOf(path->second), path->second,
-                          camera.width(), camera.height());
+                          model.width(), model.height());
   } catch (const std::exception& error) {
     // The reconstruction already reported unreadable images; here the
     // evidence is simply unknown.
     VLOG(1) << "paint probe: " << error.what();
   }
   ++images_read_;
-  cache_.emplace_front(exposure_id, image);
+  cache_.emplace_front(key, image);
   if (static_cast<int>(cache_.size()) > options_.cached_images) {
     cache_.pop_back();
   }
@@ -156,11 +179,19 @@ PaintEvidence ImagePaintProbe::Classify(
   if (image == nullptr) return PaintEvidence::kUnknown;
   const Eigen::Isometry3d T_cam_enu =
       (pose.T_enu_body() * survey_.rig.cameras[camera_].T_body_cam).inverse();
+  // Every verdict is first checked for something standing over the place:
+  // a dark, even vehicle side looks like bare road, a white one like paint
+  // (measured: a truck over a band read as paint in 12 of 17 views).
+  auto unless_occluded = [&](PaintEvidence evidence) {
+    return StandsAboveRoad(exposure_id, pose, band) ? PaintEvidence::kOccluded
+                                                    : evidence;
+  };
   if (seen.empty()) {
     const double road = RoadAheadLevel(*image, T_cam_enu, band);
-    if (!(road > 1.0)) return PaintEvidence::kUnknown;
-    return Verdict(*image, T_cam_enu, band, options_.assumed_paint_contrast,
-                   road, exposure_id);
+    if (!(road > 1.0)) return unless_occluded(PaintEvidence::kUnknown);
+    return unless_occluded(Verdict(*image, T_cam_enu, band,
+                                   options_.assumed_paint_contrast, road,
+                                   exposure_id));
   }
   // Paint: the seen bands. Asphalt: the gaps between neighbouring ones.
   std::vector<float> paint, asphalt, values;
@@ -176,17 +207,20 @@ PaintEvidence ImagePaintProbe::Classify(
       }
     }
   }
-  if (paint.empty() || asphalt.empty()) return PaintEvidence::kUnknown;
+  if (paint.empty() || asphalt.empty()) {
+    return unless_occluded(PaintEvidence::kUnknown);
+  }
   double paint_level, paint_spread, road_level, road_spread;
   Quartiles(&paint, &paint_level, &paint_spread);
   Quartiles(&asphalt, &road_level, &road_spread);
   // Ratios, not differences: a cast shadow multiplies paint and asphalt
   // alike, so the band is compared with the surface right beside it.
   if (!(road_level > 1.0) || paint_level - road_level < options_.min_contrast) {
-    return PaintEvidence::kUnknown;
+    return unless_occluded(PaintEvidence::kUnknown);
   }
-  return Verdict(*image, T_cam_enu, band, paint_level / road_level - 1.0, 0.0,
-                 exposure_id);
+  return unless_occluded(Verdict(*image, T_cam_enu, band,
+                                 paint_level / road_level - 1.0, 0.0,
+                                 exposure_id));
 }
 
 double ImagePaintProbe::RoadAheadLevel(const cv::Mat& image,

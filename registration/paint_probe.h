@@ -35,7 +35,10 @@
 
 namespace zebrageo {
 
-enum class PaintEvidence { kUnknown, kPaint, kBareRoad };
+// kOccluded: something stands above the road at the place (issue 52): the
+// stereo pair's right image matches the left one there in front of the
+// road surface, not on it.
+enum class PaintEvidence { kUnknown, kPaint, kBareRoad, kOccluded };
 
 const char* PaintEvidenceName(PaintEvidence evidence);
 
@@ -67,6 +70,24 @@ struct PaintProbeOptions {
   // or a shadow over the crossing is not bare road.
   double assumed_paint_contrast = 0.5;
   double max_road_level_change = 0.25;
+  // Occlusion by stereo (issue 52): at grid points of the place seen in
+  // the left image, windows of occlusion_window_px (odd) are compared with
+  // the right image's where the road surface puts them and where a surface
+  // at least occlusion_min_height_m above it would (swept along the left
+  // ray, one pixel of disparity a step). A point with texture (window sd
+  // at least occlusion_min_texture grey levels) stands above the road when
+  // its best match above beats the road's by occlusion_ncc_margin at
+  // correlation occlusion_min_ncc, on the road when the road's match
+  // reaches occlusion_min_ncc (else it does not vote); the place is
+  // occluded when at least occlusion_min_points and occlusion_min_share of
+  // the votes are above the road (docs/results.md, issue 52).
+  int occlusion_window_px = 5;
+  double occlusion_min_height_m = 0.5;
+  double occlusion_min_texture = 4.0;
+  double occlusion_min_ncc = 0.7;
+  double occlusion_ncc_margin = 0.25;
+  int occlusion_min_points = 6;
+  double occlusion_min_share = 0.4;
   // Decoded images kept in memory.
   int cached_images = 16;
 
@@ -81,6 +102,13 @@ struct PaintProbeOptions {
     v("min_inside_share", min_inside_share);
     v("assumed_paint_contrast", assumed_paint_contrast);
     v("max_road_level_change", max_road_level_change);
+    v("occlusion_window_px", occlusion_window_px);
+    v("occlusion_min_height_m", occlusion_min_height_m);
+    v("occlusion_min_texture", occlusion_min_texture);
+    v("occlusion_min_ncc", occlusion_min_ncc);
+    v("occlusion_ncc_margin", occlusion_ncc_margin);
+    v("occlusion_min_points", occlusion_min_points);
+    v("occlusion_min_share", occlusion_min_share);
     v("cached_images", cached_images);
   }
 };
@@ -111,6 +139,14 @@ class ImagePaintProbe {
   bool Sample(const cv::Mat& image, const Eigen::Isometry3d& T_cam_enu,
               const BandCornersEnu& quad, std::vector<float>* values) const;
   const cv::Mat* LeftImage(int64_t exposure_id);
+  // The image of `camera` of the exposure (cached), or null.
+  const cv::Mat* CameraImage(int64_t exposure_id, int camera);
+  // True when the stereo pair shows something standing above the road at
+  // `band`'s place (see the occlusion options).
+  bool StandsAboveRoad(int64_t exposure_id, const Pose& pose,
+                       const BandCornersEnu& band);
+  bool MeasureStandsAboveRoad(int64_t exposure_id, const Pose& pose,
+                              const BandCornersEnu& band);
   // The verdict on `band` given the paint contrast (paint / asphalt - 1)
   // and, when positive, the road's level ahead of the vehicle.
   PaintEvidence Verdict(const cv::Mat& image,
@@ -126,9 +162,14 @@ class ImagePaintProbe {
   const Survey& survey_;
   PaintProbeOptions options_;
   int camera_ = -1;  // the left camera of the first stereo pair
+  int right_camera_ = -1;
   std::unordered_map<int64_t, std::string> image_of_exposure_;
-  std::list<std::pair<int64_t, cv::Mat>> cache_;  // most recent first
+  std::unordered_map<int64_t, std::string> right_image_of_exposure_;
+  // Keyed by exposure * 2 + (0 left, 1 right), most recent first.
+  std::list<std::pair<int64_t, cv::Mat>> cache_;
   int images_read_ = 0;
+  // StandsAboveRoad's answers by exposure and quarter-metre cell.
+  std::unordered_map<uint64_t, bool> occlusion_cache_;
 };
 
 }  // namespace zebrageo

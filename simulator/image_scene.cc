@@ -147,6 +147,11 @@ void ImageScene::AddItems() {
     box.max().array() += 1.4 * st.radius_m;
     if (view.intersects(box)) items.push_back({(kItemStain << 24) | i, box});
   }
+  for (int i = 0; i < static_cast<int>(world_.beside_marks.size()); ++i) {
+    const Eigen::AlignedBox2d box =
+        box_of(world_.beside_marks[i].polygon, 0.05);
+    if (view.intersects(box)) items.push_back({(kItemBeside << 24) | i, box});
+  }
   for (int i = 0; i < static_cast<int>(world_.shadows.size()); ++i) {
     const Eigen::AlignedBox2d box = box_of(world_.shadows[i].polygon, 0.1);
     if (view.intersects(box)) items.push_back({(kItemShadow << 24) | i, box});

@@ -36,6 +36,7 @@ enum Material : uint32_t {
   kWall,
   kWindow,
   kVehicle,
+  kBesidePaint,
 };
 constexpr uint32_t kShadowBit = 0x800000;
 
@@ -153,7 +154,8 @@ enum ItemType : uint32_t {
   kItemCrossing = 1,
   kItemManhole,
   kItemStain,
-  kItemShadow
+  kItemShadow,
+  kItemBeside
 };
 
 }  // namespace zebrageo::sim::render_internal

@@ -103,6 +103,18 @@ void CheckStreetRanges(const SimulationOptions& o, Checker* c) {
            o.min_side_crossing_setback_m, 30.0);
   c->Range("side_crossing_vehicle_probability",
            o.side_crossing_vehicle_probability, 0.0, 1.0);
+  c->Range("bike_squares_probability", o.bike_squares_probability, 0.0, 1.0);
+  c->Range("two_square_rows_probability", o.two_square_rows_probability, 0.0,
+           1.0);
+  c->Range("bike_lane_probability", o.bike_lane_probability, 0.0, 1.0);
+  c->Range("square_size_m", o.square_size_m, 0.2, 1.0);
+  c->Range("square_column_probability", o.square_column_probability, 0.0, 1.0);
+  c->Range("give_way_teeth_probability", o.give_way_teeth_probability, 0.0,
+           1.0);
+  c->Range("min_stop_line_distance_m", o.min_stop_line_distance_m, 0.5, 10.0);
+  c->Range("max_stop_line_distance_m", o.max_stop_line_distance_m,
+           o.min_stop_line_distance_m, 10.0);
+  c->Range("truck_probability", o.truck_probability, 0.0, 1.0);
   c->Range("missing_paint_probability", o.missing_paint_probability, 0.0, 1.0);
   c->Range("stop_line_probability", o.stop_line_probability, 0.0, 1.0);
   c->Range("lane_line_width_m", o.lane_line_width_m, 0.05, 0.5);

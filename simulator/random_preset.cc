@@ -305,7 +305,7 @@ void DrawDatabase(std::mt19937_64* rng, const std::string& kind,
 // each way, the vehicle in any lane. The other draws do not change.
 void DrawAvenue(uint64_t seed, const RandomPresetLimits& limits,
                 SimulationOptions* o) {
-  std::mt19937_64 rng(sim::SubSeed(seed, kRandomPresetSeed, 52));
+  std::mt19937_64 rng(sim::SubSeed(seed, kRandomPresetSeed, 520));
   const bool drawn = Bernoulli(&rng, 0.2);
   const double width = Uniform(&rng, 14.0, 24.0);
   const double median = Uniform(&rng, 1.5, 4.0);
@@ -370,6 +370,21 @@ std::string DrawRandomOptions(uint64_t seed, const RandomPresetLimits& limits,
   DrawDatabase(&rng, o.scenario, &o);
   DrawJunctions(seed, limits, &o);
   DrawAvenue(seed, limits, &o);
+  // Paint beside the crossings and stop lines 1-5 m before them (issue
+  // 52), from their own generator: the other draws do not change. Not the
+  // trucks (truck_probability, --set): they would change the occlusions of
+  // the geometry sweep's surveys.
+  {
+    std::mt19937_64 beside(sim::SubSeed(seed, kRandomPresetSeed, 52));
+    o.bike_squares_probability = Uniform(&beside, 0.0, 0.6);
+    o.two_square_rows_probability = Uniform(&beside, 0.2, 0.8);
+    o.bike_lane_probability = Uniform(&beside, 0.3, 1.0);
+    o.square_size_m = Uniform(&beside, 0.4, 0.6);
+    o.square_column_probability = Uniform(&beside, 0.0, 0.3);
+    o.give_way_teeth_probability = Uniform(&beside, 0.0, 0.5);
+    o.min_stop_line_distance_m = 1.0;
+    o.max_stop_line_distance_m = 5.0;
+  }
   // Extra crossings only in the database go on the road too.
   const double longest_crossing =
       o.max_band_length_m + o.road_width_m * std::tan(30.0 * kPi / 180.0);

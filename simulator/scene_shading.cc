@@ -128,6 +128,61 @@ void ShadeBuilding(const Building& b, const VerticalBox& box,
   }
 }
 
+// A truck's body at p (u, v along the box's axes): ribbed, lettered and
+// dirty box sides (the texture a stereo pair measures on real trucks), a
+// darker cab at the -u end (it faces the survey vehicle) with a windscreen,
+// wheels and the dark gap under the body.
+void ShadeTruck(const ParkedVehicle& truck, const VerticalBox& box,
+                const Eigen::Vector3d& p, double u, double v, int face,
+                uint64_t id, float* value, uint32_t* key) {
+  const double height = box.z1 - box.z0;
+  const double h = p.z() - box.z0;
+  const bool side = face >= 2;
+  const double across = side ? u : v;  // along the face
+  *key = Key(kVehicle, id * 8);
+  // Grime and print at a few centimetres: the fine texture of a real body.
+  const float grain =
+      0.92f + 0.16f * ValueNoise(across / 0.05, h / 0.05, truck.salt + 11);
+  if (h < 0.5 && face != 4) {
+    // Bumper, mudguards, axles and tyres: dark, with their edges.
+    const double wheel = std::abs(std::abs(across) -
+                                  (side ? box.half_u - 1.2 : box.half_v - 0.4));
+    const bool tyre = side && std::hypot(wheel, h - 0.5) < 0.5;
+    const bool bumper =
+        h > 0.3 && std::fmod(std::abs(across) + 10.0, 0.7) < 0.5;
+    *value = (tyre ? 28.0f : bumper ? 60.0f : 18.0f) * grain;
+    *key = Key(kVehicle, id * 8 + (tyre ? 3 : 1));
+    return;
+  }
+  const bool cab = u < -box.half_u + 2.2;
+  const float dirt =
+      0.82f + 0.3f * ValueNoise(across / 0.6, h / 0.6, truck.salt + face);
+  if (cab) {
+    *value = 0.7f * truck.body_tone * dirt * grain;
+    *key = Key(kVehicle, id * 8 + 6);
+    if (h > 0.55 * height && h < 0.85 * height &&
+        (face == 0 || (side && u < -box.half_u + 1.6))) {
+      *value = 45.0f * grain;  // windscreen, side window
+      *key = Key(kVehicle, id * 8 + 4);
+    }
+    return;
+  }
+  // Vertical ribs every 0.3 m, lettering: dark blocks over the sides, a
+  // panel seam near the top.
+  const double rib = std::fmod(std::abs(across) + 10.0, 0.3);
+  float tone = truck.body_tone * dirt * grain * (rib < 0.04 ? 0.78f : 1.0f);
+  if (h > 0.7 && h < height - 0.4) {
+    const int64_t gx = static_cast<int64_t>(std::floor(across / 0.18));
+    const int64_t gy = static_cast<int64_t>(std::floor(h / 0.25));
+    if (HashToUnit(HashLattice(gx, gy, truck.salt + 9)) < 0.35f) {
+      tone = 40.0f + 30.0f * HashToUnit(HashLattice(gx, gy, truck.salt + 10));
+      *key = Key(kVehicle, id * 8 + 7);
+    }
+  }
+  if (h > height - 0.25) tone *= 0.85f;
+  *value = tone;
+}
+
 // A parked vehicle's body at p (u, v along the box's axes): roof, tyres
 // and wheels, windows, head and tail lights.
 void ShadeVehicle(const ParkedVehicle& car, const VerticalBox& box,
@@ -136,6 +191,10 @@ void ShadeVehicle(const ParkedVehicle& car, const VerticalBox& box,
   const double height = box.z1 - box.z0;
   const double h = p.z() - box.z0;
   *value = car.body_tone;
+  if (car.truck) {
+    ShadeTruck(car, box, p, u, v, face, id, value, key);
+    return;
+  }
   *key = Key(kVehicle, id * 8);
   if (face == 4) {
     *value *= 1.05f;
@@ -330,6 +389,20 @@ Sample ImageScene::ShadeGround(const Eigen::Vector3d& d, double t,
               0.75 + 0.5 * ValueNoise(p.x() / 0.25, p.y() / 0.25, st.salt);
           const double amount = 1.0 - SmoothStep(0.5 * shape, shape, r);
           stain *= static_cast<float>(1.0 - amount * (1.0 - st.darkness));
+        }
+      } else if (type == kItemBeside) {
+        const BesideMark& mark = world_.beside_marks[index];
+        if (mark.Contains(p.head<2>())) {
+          const float alpha =
+              mark.white
+                  ? PaintAlpha(p.x(), p.y(), world_.paint_wear, mark.salt)
+                  : 0.95f;
+          const float tone =
+              mark.white ? PaintTone(p.x(), p.y(), footprint, mark.salt)
+                         : mark.tone * AsphaltTexture(p.x(), p.y(), footprint,
+                                                      salt + 81);
+          value = value * (1.0f - alpha) + alpha * tone;
+          key = Key(kBesidePaint, index);
         }
       } else if (type == kItemShadow) {
         const Shadow& shadow = world_.shadows[index];

@@ -131,6 +131,12 @@ nlohmann::json CrossingJson(const World& world, const sim::Crossing& c) {
   j["occluded_by_vehicle"] = c.occluded_by_vehicle;
   if (!c.db_missing_bands.empty()) j["db_missing_bands"] = c.db_missing_bands;
   if (!c.end_band_vehicle.empty()) j["end_band_vehicle"] = c.end_band_vehicle;
+  // Issue 52: the paint beside it (not bands) and a truck standing on it.
+  if (!c.beside.empty()) j["beside"] = c.beside;
+  if (c.truck) {
+    j["truck"] = true;
+    j["truck_bands"] = c.truck_bands;
+  }
   // Which street it spans: the road driven, or a side street (issue 51).
   j["across"] = c.side_street < 0 ? "road" : "side_street";
   if (c.side_street >= 0) {

@@ -147,6 +147,32 @@ struct SimulationOptions {
   int lanes_per_direction = 1;
   int num_lane_changes = 0;
 
+  // ------------------------------------------------------------ paint beside
+  // Paint beside the crossings of the road driven (issue 52), none of it a
+  // zebra band (not in the database nor truth/roadmarks.geojson), from its
+  // own generator (all 0: the street is the same as before). Per crossing:
+  // rows of white bicycle squares (square_size_m, gaps as wide) along one
+  // of its sides, a second row with two_square_rows_probability and then a
+  // coloured bicycle lane between the two with bike_lane_probability (grey
+  // images: a mid-grey coat); a column of squares one band period beyond
+  // its last band, along the bands (a cycle track's edge: the "extra row"
+  // that must not shift band ids); give-way teeth across the driving lane
+  // before it.
+  double bike_squares_probability = 0.0;
+  double two_square_rows_probability = 0.5;
+  double bike_lane_probability = 0.5;
+  double square_size_m = 0.5;
+  double square_column_probability = 0.0;
+  double give_way_teeth_probability = 0.0;
+  // The stop line's distance before the crossing (or its paint beside),
+  // drawn per crossing; 2 and 2: as before.
+  double min_stop_line_distance_m = 2.0;
+  double max_stop_line_distance_m = 2.0;
+  // Probability per crossing of the road driven of a truck (7-10 m long,
+  // 2.5 m wide, 3.2-3.8 m high) standing on it in the oncoming lane: the
+  // bands under it are hidden from every view.
+  double truck_probability = 0.0;
+
   // ------------------------------------------------------------ other marks
   // Solid edge lines and a dashed centre line (also in the database).
   bool lane_lines = true;

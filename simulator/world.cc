@@ -243,14 +243,15 @@ void PaintBands(const SimulationOptions& options, World* world) {
   }
 }
 
-// The stop line across the driving lane, 2 m before crossing `ci`.
+// The stop line across the driving lane, 1-5 m before crossing `ci`.
 void PaintLines(const SimulationOptions& options, World* world) {
   const Road& road = world->road;
   const double half = 0.5 * road.width_m();
   std::vector<std::pair<double, double>> holes;
   for (const Crossing& c : world->crossings) {
     if (c.in_street && c.side_street < 0) {
-      holes.push_back({c.s_min - 1.0, c.s_max + 1.0});
+      holes.push_back({c.s_min - 1.0 - c.beside_before_m,
+                       c.s_max + 1.0 + c.beside_after_m});
     }
   }
   if (options.lane_lines) {
@@ -439,7 +440,13 @@ StopLine StopLineBefore(const World& world, int ci,
   const Crossing& c = world.crossings[ci];
   StopLine line;
   line.width_m = 0.3;
-  line.s_m = c.s_min - 2.0 - 0.5 * line.width_m;
+  // Drawn per crossing from its salt (2 m when min = max = 2: as before),
+  // before the paint beside it (issue 52).
+  const double distance =
+      options.min_stop_line_distance_m +
+      (options.max_stop_line_distance_m - options.min_stop_line_distance_m) *
+          HashToUnit(Mix64(c.salt + 5252));
+  line.s_m = c.s_min - c.beside_before_m - distance - 0.5 * line.width_m;
   line.l0 = -0.5 * world.road.width_m() + kEdgeLineInsetM;
   line.l1 = -0.5 * options.lane_line_width_m - 0.05;
   line.crossing = ci;
@@ -548,6 +555,7 @@ World BuildWorld(const SimulationOptions& options) {
   SplitCrossingsAtIsland(options, &world);
   PlaceJunctions(options, &world);
   PaintBands(options, &world);
+  world_internal::PaintBeside(options, &world);
   PaintLines(options, &world);
   PaintAvenueLines(options, &world);
   PlanDatabaseLineFaults(options, &world);
@@ -557,6 +565,7 @@ World BuildWorld(const SimulationOptions& options) {
   ParkVehicles(options, &world);
   ParkOverEndBands(options, &world);
   ParkAtSideCrossings(options, &world);
+  world_internal::ParkTrucks(options, &world);
   CastShadows(options, &world);
   for (Shadow& shadow : world.shadows) shadow.Finish();
   return world;

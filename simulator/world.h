@@ -65,6 +65,9 @@ struct ParkedVehicle {
   float body_tone = 120.0f;
   double s0 = 0.0, s1 = 0.0;
   bool occludes_crossing = false;
+  // A truck standing on a crossing (issue 52): a box body with lettered,
+  // ribbed sides (texture a stereo pair can measure) and a cab.
+  bool truck = false;
   uint64_t salt = 0;
 };
 
@@ -133,6 +136,15 @@ struct Crossing {
   std::string island_form;
   std::vector<int> island_bands;
   std::string other_half;
+  // Paint beside it (world_paint_beside.cc, issue 52): how far it reaches
+  // before s_min and after s_max (the stop line and the lane lines keep
+  // clear of it), what it is ("squares", "squares+lane+squares", ...), and
+  // a truck standing on it (the bands under it, 1-based).
+  double beside_before_m = 0.0;
+  double beside_after_m = 0.0;
+  std::vector<std::string> beside;
+  bool truck = false;
+  std::vector<int> truck_bands;
 };
 
 // The vehicle moving to a neighbouring lane between road positions s0 and
@@ -140,6 +152,23 @@ struct Crossing {
 struct LaneChange {
   double s0 = 0.0, s1 = 0.0;
   double l_from = 0.0, l_to = 0.0;
+};
+
+// Paint beside a crossing that is not a zebra band (issue 52): a bicycle
+// square, a coloured bicycle lane, a give-way tooth. Convex polygon on the
+// road surface, counter-clockwise; not in the database nor the truth.
+struct BesideMark {
+  std::string kind;  // "square", "bike_lane", "tooth"
+  int crossing = -1;
+  std::vector<Eigen::Vector2d> polygon;
+  // Grey level fully lit; white paint is worn like the bands, a coloured
+  // surface (the renderer is grey: a red lane is a mid-grey coat) is not.
+  float tone = 212.0f;
+  bool white = true;
+  uint64_t salt = 0;
+
+  // True when xy lies inside the polygon.
+  bool Contains(const Eigen::Vector2d& xy) const;
 };
 
 // A side street meeting the road at a junction (issue 51). Its surface is
@@ -231,6 +260,7 @@ struct World {
   std::vector<Band> bands;  // painted bands, grouped by crossing
   std::vector<LinePiece> lines;
   std::vector<StopLine> stop_lines;
+  std::vector<BesideMark> beside_marks;
   std::vector<DatabaseLineFault> database_line_faults;
   std::vector<Manhole> manholes;
   std::vector<Stain> stains;

@@ -35,7 +35,8 @@ constexpr double kBandKerbMarginM = 0.25;
 std::vector<std::pair<double, double>> Subtract(
     double s0, double s1, std::vector<std::pair<double, double>> holes);
 
-// The stop line painted 2 m before crossing `ci`, across the right lane.
+// The stop line painted min/max_stop_line_distance_m before crossing `ci`
+// (and the paint beside it), across the right lane.
 StopLine StopLineBefore(const World& world, int ci,
                         const SimulationOptions& options);
 
@@ -69,6 +70,12 @@ void BuildFacades(const SimulationOptions& options, World* world);
 void ParkVehicles(const SimulationOptions& options, World* world);
 void ParkOverEndBands(const SimulationOptions& options, World* world);
 void CastShadows(const SimulationOptions& options, World* world);
+
+// Paint beside the crossings (world_paint_beside.cc, issue 52), after the
+// crossings and before the lines; trucks standing on crossings, after the
+// other vehicles. Each from its own generator.
+void PaintBeside(const SimulationOptions& options, World* world);
+void ParkTrucks(const SimulationOptions& options, World* world);
 
 }  // namespace zebrageo::sim::world_internal
 

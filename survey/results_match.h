@@ -77,8 +77,10 @@ struct UnrecognisedMark {
   std::string crossing_id;
   int band = 0;  // 0: the whole crossing
   Eigen::Vector2d location_enu = Eigen::Vector2d::Zero();
-  // "paint seen" (painted, not reconstructed or not matched), "occluded or
-  // not told" (neither paint nor bare road in the images), "no images".
+  // "paint seen" (painted, not reconstructed or not matched), "occluded"
+  // (the stereo pair shows something standing above the road at its
+  // place), "occluded or not told" (neither paint nor bare road in the
+  // images), "no images".
   std::string why;
   int views = 0;
   std::vector<int64_t> exposure_ids;

@@ -18,11 +18,12 @@ namespace {
 // (where the camera really was), is paint where the street has a band
 // (unknown on the bands of `hidden_crossing`: a vehicle over it), bare road
 // elsewhere.
-MatchInput WithImageLikeProbe(const SyntheticScene& scene,
-                              const RoadmarkIndex& index,
-                              const std::string& hidden_crossing = "") {
+MatchInput WithImageLikeProbe(
+    const SyntheticScene& scene, const RoadmarkIndex& index,
+    const std::string& hidden_crossing = "",
+    PaintEvidence hidden_as = PaintEvidence::kUnknown) {
   MatchInput input = scene.Input(index);
-  input.paint_probe = [&scene, hidden_crossing](
+  input.paint_probe = [&scene, hidden_crossing, hidden_as](
                           int64_t exposure_id, const Pose& pose,
                           const BandCornersEnu& band,
                           const std::vector<BandCornersEnu>&) {
@@ -35,14 +36,13 @@ MatchInput WithImageLikeProbe(const SyntheticScene& scene,
       const Eigen::Vector3d c =
           0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
       if ((c - centre).head<2>().norm() > 0.3) continue;
-      return key.first == hidden_crossing ? PaintEvidence::kUnknown
-                                          : PaintEvidence::kPaint;
+      return key.first == hidden_crossing ? hidden_as : PaintEvidence::kPaint;
     }
     for (const auto& [key, corners] : scene.truth) {
       const Eigen::Vector3d c =
           0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
       if (key.first == hidden_crossing && (c - centre).head<2>().norm() < 2.0) {
-        return PaintEvidence::kUnknown;  // under the vehicle
+        return hidden_as;  // under the vehicle
       }
     }
     return PaintEvidence::kBareRoad;
@@ -51,11 +51,13 @@ MatchInput WithImageLikeProbe(const SyntheticScene& scene,
 }
 
 // The matcher on `scene` with the probe above.
-MatchResult MatchWithImageLikeProbe(const SyntheticScene& scene,
-                                    const std::string& hidden_crossing = "") {
+MatchResult MatchWithImageLikeProbe(
+    const SyntheticScene& scene, const std::string& hidden_crossing = "",
+    PaintEvidence hidden_as = PaintEvidence::kUnknown) {
   const RoadmarkIndex index(scene.database, scene.frame);
-  return MatchBands(WithImageLikeProbe(scene, index, hidden_crossing),
-                    MatchOptions());
+  return MatchBands(
+      WithImageLikeProbe(scene, index, hidden_crossing, hidden_as),
+      MatchOptions());
 }
 
 // The fault rests on the images: bare road where the crossing should be.
@@ -120,6 +122,34 @@ TEST(BandMatcherFaults, ACrossingHiddenByAVehicleIsNotGoneFromTheStreet) {
   EXPECT_EQ(status["C03"], "not recognised");
   EXPECT_EQ(status.size(), 5u);
   for (const auto& [id, what] : status) EXPECT_FALSE(what.empty()) << id;
+}
+
+// The same crossing where the stereo pair shows something standing over
+// its bands (the probe's occlusion test, issue 52): reported occluded, in
+// the crossings in view too (issue 51 point 4), never gone.
+TEST(BandMatcherFaults, ACrossingTheImagesShowCoveredIsReportedOccluded) {
+  SyntheticSceneOptions options = RandomStreetScene(9, 5);
+  SyntheticCrossingSpec& hidden = options.crossings[2];
+  hidden.occluded_bands = hidden.bands;
+  hidden.occluded_beyond_m = 0.0;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MatchResult result =
+      MatchWithImageLikeProbe(scene, "C03", PaintEvidence::kOccluded);
+  SCOPED_TRACE(result.summary.BriefReport());
+  EXPECT_EQ(ScoreMatches(scene, result.matches).wrong, 0);
+  for (const DatabaseFault& fault : result.faults) {
+    EXPECT_NE(fault.crossing_id, "C03") << fault.description;
+  }
+  const UnrecognisedMark* mark = FindUnrecognised(result, "C03", 0);
+  ASSERT_NE(mark, nullptr);
+  EXPECT_EQ(mark->why, "occluded");
+  EXPECT_NE(mark->description.find("standing above the road"),
+            std::string::npos);
+  std::string status;
+  for (const CrossingInView& c : result.crossings_in_view) {
+    if (c.crossing_id == "C03") status = c.status;
+  }
+  EXPECT_EQ(status, "occluded");
 }
 
 // A crossing the reconstruction missed whole (a design it does not know)
