@@ -1,6 +1,7 @@
 // `geometry_sweep [--seeds A-B] [--threads N] [--only KIND] [--max-length M]
 //                 [--no-rematch] [--no-lines] [--no-never-worse]
 //                 [--no-outage-readings] [--no-images] [--junctions N]
+//                 [--avenues -1|0|1]
 //                 [--verbose SEED -o DIR]`
 //
 // Issue 17's geometry sweep: for each seed, a random simulated survey in
@@ -76,6 +77,11 @@ int Main(int argc, char** argv) {
                  "preset, 0 none, N exactly N")
       ->capture_default_str()
       ->check(CLI::Range(-1, 20));
+  app.add_option("--avenues", options.avenues,
+                 "avenues (issue 52): -1 drawn by the random preset, 0 "
+                 "none, 1 every survey")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 1));
   app.add_option("--verbose", verbose_seed,
                  "dump this seed's survey and results to -o DIR");
   app.add_option("-o,--output", output, "folder of --verbose");

@@ -27,6 +27,8 @@
 # trucks on them; a survey already rendered under WORK is not rendered
 # again: give the sweep its own WORK); the table bins recall of ladder
 # crossings apart too.
+# AVENUES=1 (issue 52) makes every survey an avenue (AVENUES=-1 one
+# in five; unset or 0, none).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 n="${1:-30}"
@@ -53,6 +55,7 @@ for seed in $seeds; do
     rm -rf "$survey"
     "$zebrageo" --log-level error simulate --preset random --seed "$seed" \
       --max-road-length "$max_length" ${JUNCTIONS:+--junctions "$JUNCTIONS"} \
+      ${AVENUES:+--avenues "$AVENUES"} \
       "${sim_set[@]}" -o "$survey"
   fi
   rm -rf "$results"

@@ -84,10 +84,11 @@ IndexedCrossing CrossingGeometry(const std::string& crossing_id,
         std::atan2(span.dot(crossing.band_axis), span.dot(normal));
   }
   for (size_t i = 1; i < members.size(); ++i) {
-    for (int n = bands[members[i - 1]].band + 1; n < bands[members[i]].band;
-         ++n) {
-      crossing.missing_band_numbers.push_back(n);
-    }
+    const int from = bands[members[i - 1]].band + 1;
+    const int to = bands[members[i]].band;
+    std::vector<int>& gap = to - from >= 2 ? crossing.island_band_numbers
+                                           : crossing.missing_band_numbers;
+    for (int n = from; n < to; ++n) gap.push_back(n);
   }
   for (int b : members) {
     for (const Eigen::Vector3d& corner : bands[b].corners_enu) {

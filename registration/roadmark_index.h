@@ -65,6 +65,12 @@ struct IndexedCrossing {
   // Band numbers absent between first_band and last_band (the database
   // lost them, or the crossing has a gap).
   std::vector<int> missing_band_numbers;
+  // Runs of two or more consecutive absent numbers: a refuge island's
+  // places (SURVEY_FORMAT.md: a crossing an island interrupts may skip
+  // them), where nothing is painted. Not in missing_band_numbers, so no
+  // band is implied there and a band seen there contradicts the fit
+  // (issue 52: a band of one half never takes the other half's id).
+  std::vector<int> island_band_numbers;
   // The implied bands (indices in RoadmarkIndex::bands()): numbers 1 ..
   // first_band - 1 and missing_band_numbers, where the period is known
   // (at least two held bands).

@@ -121,8 +121,12 @@ void ImageScene::AddItems() {
     if (!crossing.in_street || first_band_[c] < 0) continue;
     if (crossing.s_max < s_lo_ || crossing.s_min > s_hi_) continue;
     Eigen::AlignedBox2d box;
-    for (int b = 0; b < crossing.num_street_bands; ++b) {
-      box.extend(box_of(world_.bands[first_band_[c] + b].corners,
+    // Its painted bands follow each other in world_.bands (an island's
+    // places, issue 52, are not among them); a ladder's bars lie beside.
+    for (int i = first_band_[c]; i < static_cast<int>(world_.bands.size()) &&
+                                 world_.bands[i].crossing == c;
+         ++i) {
+      box.extend(box_of(world_.bands[i].corners,
                         0.3 + crossing.ladder_bar_width_m));
     }
     items.push_back({(kItemCrossing << 24) | c, box});

@@ -271,10 +271,12 @@ TruePose TruePoseAt(const SimulationOptions& options, const World& world,
                     const SpeedProfile& speed, const Suspension& suspension,
                     double t, double sk) {
   const Road& road = world.road;
-  const double l = world.lane_offset_m + 0.08 * speed.wander(t);
+  const double l = LaneOffsetAt(world, sk) + 0.08 * speed.wander(t);
   const double dl_dt =
       0.08 * (speed.wander(t + 0.01) - speed.wander(t - 0.01)) / 0.02;
-  const double theta = road.Heading(sk) + std::atan2(dl_dt, speed.Speed(t));
+  // Lane changes (issue 52) turn the vehicle by atan(dl/ds).
+  const double theta = road.Heading(sk) + std::atan2(dl_dt, speed.Speed(t)) +
+                       std::atan(LaneOffsetSlopeAt(world, sk));
   const double pitch = std::atan(road.Grade(sk)) + suspension.Pitch(t);
   const double roll = std::atan2(road.Height(sk, l + kHalfTrackM) -
                                      road.Height(sk, l - kHalfTrackM),

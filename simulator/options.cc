@@ -67,7 +67,7 @@ void CheckStreetRanges(const SimulationOptions& o, Checker* c) {
   c->Range("origin_h_m", o.origin_h_m, -1000.0, 10000.0);
   c->Range("start_heading_deg", o.start_heading_deg, -360.0, 360.0);
   c->Range("road_length_m", o.road_length_m, 30.0, 200000.0);
-  c->Range("road_width_m", o.road_width_m, 6.5, 20.0);
+  c->Range("road_width_m", o.road_width_m, 6.5, 26.0);
   c->Range("crossfall", o.crossfall, 0.0, 0.08);
   c->Range("crown_rounding_m", o.crown_rounding_m, 0.01, 2.0);
   c->Range("sidewalk_width_m", o.sidewalk_width_m, 2.0, 10.0);
@@ -299,6 +299,21 @@ void CheckConsistency(const SimulationOptions& o, Checker* c) {
   if (o.outage_duration_s > 0.0) {
     c->Require(o.drift_period_s >= 1.0, "drift_period_s: must be >= 1");
   }
+  // Avenues (issue 52): each half of the road holds a lane of 2.5 m per
+  // lane and at least 2 bands beside the island.
+  c->Range("median_width_m", o.median_width_m, 0.0, 8.0);
+  c->Range("split_crossing_probability", o.split_crossing_probability, 0.0,
+           1.0);
+  c->Range("max_stagger_m", o.max_stagger_m, 0.0, 10.0);
+  c->Range("lanes_per_direction", o.lanes_per_direction, 1, 5);
+  c->Range("num_lane_changes", o.num_lane_changes, 0, 20);
+  const double carriageway = 0.5 * (o.road_width_m - o.median_width_m);
+  c->Require(carriageway >= 2.5 * o.lanes_per_direction &&
+                 carriageway >= 2.0 * (o.band_width_m + o.band_gap_m) + 0.5,
+             "median_width_m = " + Fmt(o.median_width_m) +
+                 ": each side of it must hold lanes_per_direction lanes of "
+                 "2.5 m and 2 bands (road_width_m = " +
+                 Fmt(o.road_width_m) + ")");
 }
 
 }  // namespace
@@ -315,7 +330,7 @@ std::string SimulationOptions::Check() const {
 
 std::vector<std::string> PresetNames() {
   return {"demo",      "urban", "outage",    "long_outage", "sparse",
-          "ambiguity", "large", "junctions", "random"};
+          "ambiguity", "large", "junctions", "avenue",      "random"};
 }
 
 std::string ApplyPreset(const std::string& name, SimulationOptions* options) {
@@ -437,6 +452,25 @@ std::string ApplyPreset(const std::string& name, SimulationOptions* options) {
     o.k2 *= scale2 * scale2;
     o.k3 *= scale2 * scale2 * scale2;
     o.focal_px = focal;
+  } else if (name == "avenue") {
+    // Issue 52: a 20 m avenue with a 2.5 m median whose refuge island
+    // splits every crossing (half of them held as two crossings, staggered
+    // up to 4 m), two lanes each way, the vehicle changing lanes twice.
+    o.road_length_m = 400.0;
+    o.road_width_m = 20.0;
+    o.median_width_m = 2.5;
+    o.split_crossing_probability = 0.5;
+    o.max_stagger_m = 4.0;
+    o.lanes_per_direction = 2;
+    o.num_lane_changes = 2;
+    o.num_crossings = 5;
+    o.num_stale_crossings = 0;
+    o.max_bands_per_crossing = 24;
+    o.max_skew_deg = 15.0;
+    o.min_crossing_spacing_m = 40.0;
+    o.drift_along_track_m = 0.6;
+    o.drift_cross_track_m = 0.6;
+    o.drift_vertical_m = 0.15;
   } else if (name == "large") {
     o.road_length_m = 10000.0;
     o.num_crossings = 80;

@@ -242,7 +242,16 @@ void ImageScene::ShadeBandPaint(const Eigen::Vector3d& d, double t_box,
       1;
   for (int b = std::max(1, nearest - 1);
        b <= std::min(c.num_street_bands, nearest + 1); ++b) {
-    const Band& band = world_.bands[first_band_[index] + b - 1];
+    if (IsIslandBand(c, b)) continue;
+    // World_.bands holds the painted bands in order, without the island's
+    // places (issue 52).
+    const int before_island =
+        c.island_bands.empty()
+            ? 0
+            : std::clamp(b - c.island_bands.front(), 0,
+                         static_cast<int>(c.island_bands.size()));
+    const int band_index = first_band_[index] + b - 1 - before_island;
+    const Band& band = world_.bands[band_index];
     if (o < band.o0 - 0.3 || o > band.o1 + 0.3) continue;
     // Exact intersection with the band's planar quad.
     const double denominator = band.plane_normal.dot(d);
@@ -270,7 +279,7 @@ void ImageScene::ShadeBandPaint(const Eigen::Vector3d& d, double t_box,
         kAsphaltTone * AsphaltTexture(q.x(), q.y(), footprint, salt);
     *value = under * (1.0f - alpha) +
              alpha * PaintTone(q.x(), q.y(), footprint, band.salt);
-    *key = Key(kBandPaint, first_band_[index] + b);
+    *key = Key(kBandPaint, band_index + 1);
     *p = q;
     return;
   }

@@ -102,10 +102,17 @@ nlohmann::json CrossingJson(const World& world, const sim::Crossing& c) {
   j["crossing_id"] = c.id;
   j["in_db"] = c.in_db;
   j["in_street"] = c.in_street;
-  j["num_bands"] = c.in_street ? c.num_street_bands : 0;
-  j["num_bands_db"] =
-      c.in_db ? c.num_db_bands - static_cast<int>(c.db_missing_bands.size())
-              : 0;
+  const int island = static_cast<int>(c.island_bands.size());
+  j["num_bands"] = c.in_street ? c.num_street_bands - island : 0;
+  j["num_bands_db"] = c.in_db ? c.num_db_bands - island -
+                                    static_cast<int>(c.db_missing_bands.size())
+                              : 0;
+  // Split by an avenue's refuge island (issue 52): its database form.
+  if (!c.island_form.empty()) {
+    j["island_form"] = c.island_form;
+    if (!c.island_bands.empty()) j["island_bands"] = c.island_bands;
+    if (!c.other_half.empty()) j["other_half"] = c.other_half;
+  }
   j["skew_deg"] = c.skew_deg;
   j["band_length_m"] = c.band_length_m;
   j["band_width_m"] = c.band_width_m;

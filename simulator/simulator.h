@@ -147,6 +147,24 @@ struct SimulationOptions {
   // the side street's kerb over its outer band.
   double side_crossing_vehicle_probability = 0.3;
 
+  // ------------------------------------------------------------ avenues
+  // Issue 52: a median down the road's middle, this wide across it (0:
+  // none), whose refuge island splits every crossing of the road: the
+  // island's band places are not painted. The database holds a split
+  // crossing as two crossings (one crossing_id per half) with probability
+  // split_crossing_probability, else as one whose band numbers skip the
+  // island's places (../shared/SURVEY_FORMAT.md). The far half of a
+  // two-id crossing is staggered along the road by up to +-max_stagger_m.
+  // Drawn from their own generator: with no median the street is the same.
+  double median_width_m = 0.0;
+  double split_crossing_probability = 0.5;
+  double max_stagger_m = 0.0;
+  // Lanes per direction (the vehicle starts in one drawn at random; 1: the
+  // lane a quarter of the road's width from the right kerb, as before) and
+  // lane changes to a neighbouring lane, each over 30-60 m of road.
+  int lanes_per_direction = 1;
+  int num_lane_changes = 0;
+
   // ------------------------------------------------------------ paint beside
   // Paint beside the crossings of the road driven (issue 52), none of it a
   // zebra band (not in the database nor truth/roadmarks.geojson), from its
@@ -414,6 +432,11 @@ struct RandomPresetLimits {
   // Junctions (issue 51): -1 drawn (half the surveys have 1-3, from their
   // own generator: the other draws do not change), 0 none, N exactly N.
   int junctions = -1;
+  // Avenues (issue 52): -1 drawn (one survey in five, from their own
+  // generator), 0 none, 1 every survey an avenue. Off by default: drawn,
+  // the 500-survey geometry sweep met one wrong vertex match on a band cut
+  // short in an avenue (seed 293, docs/results.md).
+  int avenues = 0;
 };
 std::vector<std::string> RandomKinds();
 // Sets `options` (render_images and threads stay at their defaults).

@@ -28,10 +28,13 @@ using world_internal::kRoadSeed;
 using world_internal::kTextureSeed;
 using world_internal::NearCrossing;
 using world_internal::OpenFacadesAtJunctions;
+using world_internal::PaintAvenueLines;
 using world_internal::ParkAtSideCrossings;
 using world_internal::ParkOverEndBands;
 using world_internal::ParkVehicles;
 using world_internal::PlaceJunctions;
+using world_internal::PlanLanes;
+using world_internal::SplitCrossingsAtIsland;
 using world_internal::StopLineBefore;
 using world_internal::Subtract;
 
@@ -225,6 +228,7 @@ void PaintBands(const SimulationOptions& options, World* world) {
     const Crossing& c = world->crossings[ci];
     if (!c.in_street) continue;
     for (int k = 1; k <= c.num_street_bands; ++k) {
+      if (IsIslandBand(c, k)) continue;
       Band band;
       band.crossing = ci;
       band.band = k;
@@ -550,6 +554,7 @@ World BuildWorld(const SimulationOptions& options) {
   world.s_drive_start = kLeadInM;
   world.s_drive_end = kLeadInM + options.road_length_m;
   world.lane_offset_m = -0.25 * options.road_width_m;
+  PlanLanes(options, &world);
   const double elevation = DegToRad(options.sun_elevation_deg);
   const double azimuth = DegToRad(options.sun_azimuth_deg);
   world.sun_enu = Eigen::Vector3d(std::sin(azimuth) * std::cos(elevation),
@@ -558,10 +563,12 @@ World BuildWorld(const SimulationOptions& options) {
   world.paint_wear = static_cast<float>(options.paint_wear);
   world.texture_salt = SubSeed(options.seed, kTextureSeed);
   PlaceCrossings(options, &world);
+  SplitCrossingsAtIsland(options, &world);
   PlaceJunctions(options, &world);
   PaintBands(options, &world);
   world_internal::PaintBeside(options, &world);
   PaintLines(options, &world);
+  PaintAvenueLines(options, &world);
   PlanDatabaseLineFaults(options, &world);
   PlaceSmallMarks(options, &world);
   BuildFacades(options, &world);

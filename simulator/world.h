@@ -133,6 +133,13 @@ struct Crossing {
   // "turning" or "parked" when a vehicle partly hides a side-street
   // crossing, else "".
   std::string side_vehicle;
+  // A crossing split by an avenue's refuge island (issue 52): "one_id"
+  // (one crossing, its island_bands neither painted nor in the database),
+  // "near_half" or "far_half" (two crossings, other_half the other's id),
+  // else "".
+  std::string island_form;
+  std::vector<int> island_bands;
+  std::string other_half;
   // Paint beside it (world_paint_beside.cc, issue 52): how far it reaches
   // before s_min and after s_max (the stop line and the lane lines keep
   // clear of it), what it is ("squares", "squares+lane+squares", ...), and
@@ -142,6 +149,13 @@ struct Crossing {
   std::vector<std::string> beside;
   bool truck = false;
   std::vector<int> truck_bands;
+};
+
+// The vehicle moving to a neighbouring lane between road positions s0 and
+// s1 (issue 52), l_from to l_to (road offsets of the lanes' centres).
+struct LaneChange {
+  double s0 = 0.0, s1 = 0.0;
+  double l_from = 0.0, l_to = 0.0;
 };
 
 // Paint beside a crossing that is not a zebra band (issue 52): a bicycle
@@ -240,7 +254,11 @@ struct World {
   Road road;
   double s_drive_start = 0.0;  // the vehicle drives s in [start, end]
   double s_drive_end = 0.0;
-  double lane_offset_m = 0.0;  // l of the driving lane's centre (right lane)
+  // l of the driving lane's centre; with lane changes (LaneOffsetAt) the
+  // lane nearest the right kerb the vehicle drives in.
+  double lane_offset_m = 0.0;
+  double median_width_m = 0.0;  // an avenue's median (issue 52), 0 = none
+  std::vector<LaneChange> lane_changes;
   std::vector<Crossing> crossings;  // in the street and/or in the database
   std::vector<SideStreet> side_streets;
   std::vector<Band> bands;  // painted bands, grouped by crossing
@@ -282,6 +300,13 @@ std::array<Eigen::Vector3d, 4> DesignBandCorners(
 // True when crossing-frame point (o, a) (a measured from the skew line, as
 // for the bands) lies on one of the crossing's ladder bars.
 bool InLadderBar(const Crossing& crossing, double o, double a);
+// Road offset of the vehicle's lane centre at road position s, and its
+// derivative dl/ds (lane changes, issue 52; world_avenue.cc).
+double LaneOffsetAt(const World& world, double s);
+double LaneOffsetSlopeAt(const World& world, double s);
+// True when design band `band` of `crossing` is an island's place: neither
+// painted nor in the database.
+bool IsIslandBand(const Crossing& crossing, int band);
 
 // Truth: the bands painted in the street and the lines, exact.
 RoadmarkDatabase MakeTruthRoadmarks(const World& world,

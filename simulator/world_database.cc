@@ -166,7 +166,8 @@ RoadmarkDatabase MakeDatabaseRoadmarks(const World& world,
     const Eigen::Vector2d origin = c.origin_xy - c.repaint_shift_xy;
     for (int k = 1; k <= c.num_db_bands; ++k) {
       if (std::find(c.db_missing_bands.begin(), c.db_missing_bands.end(), k) !=
-          c.db_missing_bands.end()) {
+              c.db_missing_bands.end() ||
+          IsIslandBand(c, k)) {
         continue;  // the gap keeps the street's numbering
       }
       const auto corners = DesignBandCorners(world, c, k, origin);

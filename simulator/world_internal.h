@@ -68,6 +68,15 @@ void OpenFacadesAtJunctions(const SimulationOptions& options, World* world);
 // Vehicles partly hiding side-street crossings (world_junctions.cc).
 void ParkAtSideCrossings(const SimulationOptions& options, World* world);
 
+// Avenues (world_avenue.cc, issue 52), from their own generator: the
+// driving lane and lane changes (before the scenery), the road crossings
+// re-laid kerb to kerb and split by the median's island (after
+// PlaceCrossings), the lines of the median and the lanes (after
+// PaintLines). Each does nothing without a median or extra lanes.
+void PlanLanes(const SimulationOptions& options, World* world);
+void SplitCrossingsAtIsland(const SimulationOptions& options, World* world);
+void PaintAvenueLines(const SimulationOptions& options, World* world);
+
 // The scenery (world_scenery.cc), in this order after the road marks.
 void BuildFacades(const SimulationOptions& options, World* world);
 void ParkVehicles(const SimulationOptions& options, World* world);

@@ -25,6 +25,7 @@ struct SimulateArguments {
   std::string bad;
   double max_road_length_m = RandomPresetLimits().max_road_length_m;
   int junctions = RandomPresetLimits().junctions;
+  int avenues = RandomPresetLimits().avenues;
 };
 
 }  // namespace
@@ -36,8 +37,8 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
       "Write a simulated survey (images, trajectory with GNSS/INS drift, "
       "road-mark database) with its ground truth in truth/.");
   sub->add_option("--preset", args->preset,
-                  "demo, urban, outage, sparse, ambiguity, large or random "
-                  "(every knob drawn from the seed)")
+                  "demo, urban, outage, sparse, ambiguity, large, junctions, "
+                  "avenue or random (every knob drawn from the seed)")
       ->capture_default_str();
   sub->add_option("--seed", args->seed, "random seed")->capture_default_str();
   sub->add_option("-o,--output", args->output, "survey folder to write")
@@ -57,6 +58,12 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
                   "crossings across them, drawn as the preset draws them); "
                   "-1 drawn (half the surveys)")
       ->capture_default_str();
+  sub->add_option("--avenues", args->avenues,
+                  "random preset: 1 an avenue (median, refuge islands "
+                  "splitting the crossings, lanes; issue 52), 0 none, -1 "
+                  "drawn (one survey in five); default none")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 1));
   sub->add_flag("--no-images", args->no_images,
                 "write only the geometry (no rendering)");
   commands->push_back(
@@ -69,6 +76,7 @@ void AddSimulateCommand(CLI::App* app, std::vector<Command>* commands) {
            RandomPresetLimits limits;
            limits.max_road_length_m = args->max_road_length_m;
            limits.junctions = args->junctions;
+           limits.avenues = args->avenues;
            error = DrawRandomOptions(args->seed, limits, &options);
          } else {
            error = ApplyPreset(args->preset, &options);

@@ -57,10 +57,27 @@ TEST(RoadmarkIndex, MeasuresTheSkewOfASkewedCrossing) {
 }
 
 TEST(RoadmarkIndex, ListsBandNumbersTheDatabaseLacks) {
+  const SyntheticScene scene = OneCrossing(0.0, {3, 6});
+  const RoadmarkIndex index(scene.database, scene.frame);
+  const IndexedCrossing& c = index.crossings()[0];
+  EXPECT_EQ(c.missing_band_numbers, (std::vector<int>{3, 6}));
+  EXPECT_TRUE(c.island_band_numbers.empty());
+  EXPECT_NEAR(c.spacing_m, 1.0, 1e-6);
+}
+
+// Two or more numbers in a row absent: a refuge island's places (issue 52),
+// where no band is implied (a band seen there is no band the database
+// lost).
+TEST(RoadmarkIndex, ARunOfAbsentNumbersIsAnIslandWithNoImpliedBands) {
   const SyntheticScene scene = OneCrossing(0.0, {3, 4});
   const RoadmarkIndex index(scene.database, scene.frame);
   const IndexedCrossing& c = index.crossings()[0];
-  EXPECT_EQ(c.missing_band_numbers, (std::vector<int>{3, 4}));
+  EXPECT_TRUE(c.missing_band_numbers.empty());
+  EXPECT_EQ(c.island_band_numbers, (std::vector<int>{3, 4}));
+  for (int b : c.implied_bands) {
+    EXPECT_NE(index.bands()[b].band, 3);
+    EXPECT_NE(index.bands()[b].band, 4);
+  }
   EXPECT_NEAR(c.spacing_m, 1.0, 1e-6);
 }
 

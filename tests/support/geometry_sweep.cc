@@ -63,6 +63,14 @@ void ScoreMatches(const sim::SimulatedSurvey& simulated,
   std::set<std::string> matched;
   std::set<std::string> wrong;
   for (const VertexMatch& m : matches) {
+    const auto origin = reconstruction.truth_of_band.find(m.band_id);
+    if (origin != reconstruction.truth_of_band.end()) {
+      const sim::Band& band = simulated.world.bands[origin->second.world_band];
+      ++result->ids_checked;
+      result->wrong_ids +=
+          simulated.world.crossings[band.crossing].id != m.crossing_id ||
+          band.band != m.band;
+    }
     const auto corners = truth.find({m.crossing_id, m.band});
     const auto vertex = p_body.find({m.band_id, m.vertex});
     const auto pose = true_pose.find(m.exposure_id);
@@ -243,6 +251,7 @@ std::string GeometryRunResult::Line() const {
   }
   out << ", crossings " << crossings_matched << "/" << crossings_matchable
       << "; ";
+  if (wrong_ids > 0) out << wrong_ids << " WRONG IDS; ";
   if (usable) {
     out << "H " << Fixed(100 * h_before_m, 1) << "->"
         << Fixed(100 * h_after_m, 1) << " V " << Fixed(100 * v_before_m, 1)
@@ -357,6 +366,7 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
   simulation.seed = seed;
   RandomPresetLimits limits;
   limits.junctions = options.junctions;
+  limits.avenues = options.avenues;
   if (options.max_road_length_m > 0.0) {
     limits.max_road_length_m =
         std::min(limits.max_road_length_m, options.max_road_length_m);
@@ -516,6 +526,8 @@ GeometrySweepSummary Summarise(const std::vector<GeometryRunResult>& results) {
     }
     s.wrong_matches += r.wrong;
     s.wrong_on_cut_bands += r.wrong_on_cut_bands;
+    s.wrong_ids += r.wrong_ids;
+    s.ids_checked += r.ids_checked;
     s.surveys_with_wrong_matches += r.wrong > 0 ? 1 : 0;
     s.right_matches += r.right;
     s.crossings_matchable += r.crossings_matchable;
@@ -594,6 +606,8 @@ std::string GeometrySweepSummary::Report() const {
       << "  wrong vertex matches " << wrong_matches << " (in "
       << surveys_with_wrong_matches << " surveys; " << wrong_on_cut_bands
       << " on bands cut short), right " << right_matches << "\n"
+      << "  matched band ids against the truth band: " << wrong_ids
+      << " wrong of " << ids_checked << "\n"
       << "  crossings matched " << Fixed(100.0 * MatchedShare(), 1) << " % ("
       << consistent_matched << "/" << consistent_crossings
       << ") of the matchable not repainted; of all matchable "

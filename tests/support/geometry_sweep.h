@@ -42,6 +42,9 @@ struct GeometrySweepOptions {
   // Junctions of the random preset (RandomPresetLimits::junctions): -1
   // drawn, 0 none, N exactly N per survey.
   int junctions = -1;
+  // Avenues of the random preset (RandomPresetLimits::avenues, issue 52):
+  // -1 drawn, 0 none (the default), 1 every survey.
+  int avenues = 0;
   // Only surveys of this random kind (simulator.h: RandomKinds()); empty:
   // all.
   std::string only_kind;
@@ -95,6 +98,11 @@ struct GeometryRunResult {
   // vertices 0.25-1 m inside the paint): the band is the right one, its
   // vertices are not where the database's are.
   int wrong_on_cut_bands = 0;
+  // Matches whose (crossing_id, band) is not the truth band the
+  // reconstructed band came from (issue 52: across a refuge island), and
+  // matches checked so.
+  int wrong_ids = 0;
+  int ids_checked = 0;
   int crossings_matchable = 0;
   int crossings_matched = 0;
   // Matchable crossings that are not repainted: a consistent set exists.
@@ -162,6 +170,8 @@ struct GeometrySweepSummary {
   int wrong_matches = 0;
   int wrong_on_cut_bands = 0;
   int surveys_with_wrong_matches = 0;
+  int wrong_ids = 0;  // GeometryRunResult::wrong_ids, summed
+  int ids_checked = 0;
   int right_matches = 0;
   int crossings_matchable = 0;
   int crossings_matched = 0;
