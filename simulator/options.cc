@@ -307,13 +307,17 @@ void CheckConsistency(const SimulationOptions& o, Checker* c) {
   c->Range("max_stagger_m", o.max_stagger_m, 0.0, 10.0);
   c->Range("lanes_per_direction", o.lanes_per_direction, 1, 5);
   c->Range("num_lane_changes", o.num_lane_changes, 0, 20);
+  // A plain street (no median, one lane each way) is held by road_width_m's
+  // own range; the rule names the avenue's fields only where they are set.
+  const bool avenue = o.median_width_m > 0.0 || o.lanes_per_direction > 1;
   const double carriageway = 0.5 * (o.road_width_m - o.median_width_m);
-  c->Require(carriageway >= 2.5 * o.lanes_per_direction &&
-                 carriageway >= 2.0 * (o.band_width_m + o.band_gap_m) + 0.5,
-             "median_width_m = " + Fmt(o.median_width_m) +
-                 ": each side of it must hold lanes_per_direction lanes of "
-                 "2.5 m and 2 bands (road_width_m = " +
-                 Fmt(o.road_width_m) + ")");
+  c->Require(
+      !avenue || (carriageway >= 2.5 * o.lanes_per_direction &&
+                  carriageway >= 2.0 * (o.band_width_m + o.band_gap_m) + 0.5),
+      "median_width_m = " + Fmt(o.median_width_m) +
+          ": each side of it must hold lanes_per_direction lanes of "
+          "2.5 m and 2 bands (road_width_m = " +
+          Fmt(o.road_width_m) + ")");
 }
 
 }  // namespace

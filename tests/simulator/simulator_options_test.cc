@@ -48,7 +48,7 @@ TEST(SimulationOptions, UnknownPresetNamesTheKnownOnes) {
 TEST(SimulationOptions, CheckNamesTheFieldTheValueAndTheRule) {
   SimulationOptions options;
   options.road_width_m = 3.0;
-  EXPECT_EQ(options.Check(), "road_width_m = 3: must be in [6.5, 20]");
+  EXPECT_EQ(options.Check(), "road_width_m = 3: must be in [6.5, 26]");
   options = SimulationOptions();
   options.band_width_m = -0.5;
   options.threads = -2;
