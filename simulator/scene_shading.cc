@@ -296,7 +296,17 @@ void ImageScene::ShadeLadderBar(const Eigen::Vector3d& d, double t_box,
                                 Eigen::Vector3d* p, float* value,
                                 uint32_t* key) const {
   const Crossing& c = world_.crossings[index];
-  const int b = std::clamp(nearest, 1, c.num_street_bands);
+  // World_.bands holds the painted bands only: an island's places (issue
+  // 52) are not among them, so the index counts painted bands.
+  const int painted =
+      c.num_street_bands - static_cast<int>(c.island_bands.size());
+  if (painted <= 0) return;
+  const int before_island =
+      c.island_bands.empty()
+          ? 0
+          : std::clamp(nearest - c.island_bands.front(), 0,
+                       static_cast<int>(c.island_bands.size()));
+  const int b = std::clamp(nearest - before_island, 1, painted);
   const Band& band = world_.bands[first_band_[index] + b - 1];
   const double denominator = band.plane_normal.dot(d);
   if (std::abs(denominator) < 1e-9) return;
