@@ -88,6 +88,9 @@ std::string PaintProbeOptions::Check() const {
 ImagePaintProbe::ImagePaintProbe(const Survey& survey,
                                  PaintProbeOptions options)
     : survey_(survey), options_(options) {
+  for (const RoadmarkBand& band : survey.roadmarks.bands) {
+    heights_known_ = heights_known_ && band.height_known;
+  }
   if (survey.rig.stereo_pairs.empty()) return;
   camera_ = survey.rig.stereo_pairs.front()[0];
   right_camera_ = survey.rig.stereo_pairs.front()[1];

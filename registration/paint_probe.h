@@ -160,6 +160,8 @@ class ImagePaintProbe {
                         const BandCornersEnu& band) const;
 
   const Survey& survey_;
+  // False when a band of the database has no height (a 2D layer).
+  bool heights_known_ = true;
   PaintProbeOptions options_;
   int camera_ = -1;  // the left camera of the first stereo pair
   int right_camera_ = -1;

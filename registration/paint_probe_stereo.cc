@@ -85,6 +85,11 @@ bool ImagePaintProbe::StandsAboveRoad(int64_t exposure_id, const Pose& pose,
 bool ImagePaintProbe::MeasureStandsAboveRoad(int64_t exposure_id,
                                              const Pose& pose,
                                              const BandCornersEnu& band) {
+  // The test compares the road at the band's height with a surface above
+  // it. A 2D layer's heights are a guess (survey/roadmark_layer.h): the
+  // real road then stands above the guessed one and would read as an
+  // occluder, so without heights nothing is called occluded.
+  if (!heights_known_) return false;
   const cv::Mat* left = CameraImage(exposure_id, camera_);
   if (left == nullptr) return false;
   const cv::Mat left_image = *left;  // shares the data; the cache may evict
