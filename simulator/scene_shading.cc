@@ -225,6 +225,15 @@ void ShadeVehicle(const ParkedVehicle& car, const VerticalBox& box,
   }
 }
 
+// How many of an island's places (issue 52) come before design band b of
+// crossing c: world.bands holds the painted bands only, without them.
+int IslandPlacesBefore(const Crossing& c, int b) {
+  return c.island_bands.empty()
+             ? 0
+             : std::clamp(b - c.island_bands.front(), 0,
+                          static_cast<int>(c.island_bands.size()));
+}
+
 }  // namespace
 
 // The paint of the bands of crossing `index` near the ground point *p: the
@@ -245,11 +254,7 @@ void ImageScene::ShadeBandPaint(const Eigen::Vector3d& d, double t_box,
     if (IsIslandBand(c, b)) continue;
     // World_.bands holds the painted bands in order, without the island's
     // places (issue 52).
-    const int before_island =
-        c.island_bands.empty()
-            ? 0
-            : std::clamp(b - c.island_bands.front(), 0,
-                         static_cast<int>(c.island_bands.size()));
+    const int before_island = IslandPlacesBefore(c, b);
     const int band_index = first_band_[index] + b - 1 - before_island;
     const Band& band = world_.bands[band_index];
     if (o < band.o0 - 0.3 || o > band.o1 + 0.3) continue;
@@ -301,11 +306,7 @@ void ImageScene::ShadeLadderBar(const Eigen::Vector3d& d, double t_box,
   const int painted =
       c.num_street_bands - static_cast<int>(c.island_bands.size());
   if (painted <= 0) return;
-  const int before_island =
-      c.island_bands.empty()
-          ? 0
-          : std::clamp(nearest - c.island_bands.front(), 0,
-                       static_cast<int>(c.island_bands.size()));
+  const int before_island = IslandPlacesBefore(c, nearest);
   const int b = std::clamp(nearest - before_island, 1, painted);
   const Band& band = world_.bands[first_band_[index] + b - 1];
   const double denominator = band.plane_normal.dot(d);
