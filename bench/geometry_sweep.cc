@@ -69,6 +69,9 @@ int Main(int argc, char** argv) {
   app.add_option("--preset", options.preset,
                  "a named preset instead of the random one (to compare with "
                  "`zebrageo run` on the same survey)");
+  app.add_option("--set", options.sim_set,
+                 "simulator option after the draw, key=value (as simulate "
+                 "--set; repeat it)");
   app.add_option("--max-length", options.max_road_length_m,
                  "longest road drawn, metres (0: the preset's 1.5 km)")
       ->capture_default_str();

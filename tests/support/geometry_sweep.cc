@@ -375,11 +375,18 @@ GeometryRunResult RunGeometrySurvey(uint64_t seed,
                                   ? DrawRandomOptions(seed, limits, &simulation)
                                   : ApplyPreset(options.preset, &simulation);
   result.kind = options.preset.empty() ? simulation.scenario : options.preset;
-  result.params = RandomOptionsBrief(simulation);
   if (!problem.empty()) {
     result.error = problem;
     return result;
   }
+  for (const std::string& key_equals_value : options.sim_set) {
+    const std::string bad = SetOption(key_equals_value, &simulation);
+    if (!bad.empty()) {
+      result.error = "sim_set " + key_equals_value + ": " + bad;
+      return result;
+    }
+  }
+  result.params = RandomOptionsBrief(simulation);
   if (!options.only_kind.empty() && options.only_kind != result.kind) {
     result.skipped = true;
     return result;

@@ -51,6 +51,10 @@ struct GeometrySweepOptions {
   // A named preset (simulator.h) instead of the random one, with the seed:
   // to compare the sweep with `zebrageo run` on the same survey.
   std::string preset;
+  // Simulator options set after the draw, "key=value" as `simulate --set`
+  // reads them (simulator.h: SetOption): a regression seed held to the
+  // scene it was written for, or one knob of the preset swept.
+  std::vector<std::string> sim_set;
   // A survey is worse than its input when the adjusted horizontal and
   // vertical error, hypot(H, V), exceeds the input's by more than this, or
   // the attitude error by more than worse_attitude_deg.
