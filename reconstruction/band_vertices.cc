@@ -217,26 +217,14 @@ bool EndsStepLikeThePaint(const BandContext& context, int i,
   for (int e = 0; e < 2 && !failed; ++e) {
     if (known[e].line != nullptr || known[e].ladder) continue;
     // The long sides' step near this end (a shadow across the band
-    // lowers both alike): over 8-32 % of the band from the end.
-    double long_step = 0.0;
-    int long_count = 0;
-    for (int k = 0; k < 2; ++k) {
-      if (context.bands.pairs[i].inferred == k) continue;
-      const Eigen::Vector2d at_end = corner[e == 0 ? k : 3 - k];
-      const Eigen::Vector2d other_end = corner[e == 0 ? 3 - k : k];
-      const double step = EdgeStep(edges, long_lines[k], at_end,
-                                   at_end + 0.4 * (other_end - at_end),
-                                   options.end_step_profile_px);
-      if (std::isfinite(step)) {
-        long_step += step;
-        ++long_count;
-      }
-    }
-    if (long_count == 0) continue;
+    // lowers both alike).
+    const double long_step =
+        LongSideStep(context, i, edges, long_lines, corner, e);
+    if (!std::isfinite(long_step)) continue;
     const double step =
         EdgeStep(edges, transversal_lines[e], corner[e == 0 ? 0 : 3],
                  corner[e == 0 ? 1 : 2], options.end_step_profile_px);
-    const double ratio = step / (long_step / long_count);
+    const double ratio = step / long_step;
     VLOG(2) << "band " << i << " side " << side << " end " << e << ": step "
             << ratio << " of the long sides'";
     failed = !(ratio >= options.min_end_step_fraction);
@@ -549,6 +537,26 @@ BandOutcome ModelBand(const BandContext& context, int i,
     if (result == ViewResult::kFailed) return BandOutcome::kRejected;
   }
   return FinishBand(context, i, known, setup, views, end_directions, out);
+}
+
+double LongSideStep(const BandContext& context, int i, const EdgeMap& edges,
+                    const ImageLine long_lines[2],
+                    const Eigen::Vector2d corner[4], int e) {
+  double sum = 0.0;
+  int count = 0;
+  for (int k = 0; k < 2; ++k) {
+    if (context.bands.pairs[i].inferred == k) continue;
+    const Eigen::Vector2d at_end = corner[e == 0 ? k : 3 - k];
+    const Eigen::Vector2d other_end = corner[e == 0 ? 3 - k : k];
+    const double step = EdgeStep(edges, long_lines[k], at_end,
+                                 at_end + 0.4 * (other_end - at_end),
+                                 context.options.end_step_profile_px);
+    if (std::isfinite(step)) {
+      sum += step;
+      ++count;
+    }
+  }
+  return count > 0 ? sum / count : std::nan("");
 }
 
 double EndAngleRad(const std::array<Eigen::Vector3d, 4>& vertices) {

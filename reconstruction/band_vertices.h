@@ -20,6 +20,7 @@
 #include "reconstruction/road_rectification.h"
 #include "reconstruction/subpixel_edges.h"
 #include "reconstruction/transversal_search.h"
+#include "reconstruction/transversal_sides.h"
 
 namespace zebrageo {
 
@@ -65,6 +66,15 @@ BandOutcome ModelBand(const BandContext& context, int i,
                       const KnownEnd known[2],
                       std::vector<EndDirectionObservation>* end_directions,
                       Band* out);
+
+// The mean grey-level step of band i's measured long sides near its end e
+// (0 begin, 1 end), over 40 % of the band from that end in the image of
+// `edges`; `corner`: the band's vertices there. NaN when neither side can
+// be measured. A paint end steps like the long sides; a ladder bar's edge
+// or plain paint does not.
+double LongSideStep(const BandContext& context, int i, const EdgeMap& edges,
+                    const ImageLine long_lines[2],
+                    const Eigen::Vector2d corner[4], int e);
 
 // Angle (radians, 0..pi/2) between a band's two ends, v0-v1 and v3-v2
 // (vertices in order around the band): 0 for a parallelogram.

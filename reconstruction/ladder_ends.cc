@@ -9,28 +9,6 @@
 namespace zebrageo {
 namespace {
 
-// The long sides' grey-level step near end e (over 40 % of the band from
-// it), NaN when neither can be measured.
-double LongSideStep(const BandContext& context, int i, const EdgeMap& edges,
-                    const ImageLine long_lines[2],
-                    const Eigen::Vector2d corner[4], int e) {
-  double sum = 0.0;
-  int count = 0;
-  for (int k = 0; k < 2; ++k) {
-    if (context.bands.pairs[i].inferred == k) continue;
-    const Eigen::Vector2d at_end = corner[e == 0 ? k : 3 - k];
-    const Eigen::Vector2d other_end = corner[e == 0 ? 3 - k : k];
-    const double step = EdgeStep(edges, long_lines[k], at_end,
-                                 at_end + 0.4 * (other_end - at_end),
-                                 context.options.end_step_profile_px);
-    if (std::isfinite(step)) {
-      sum += step;
-      ++count;
-    }
-  }
-  return count > 0 ? sum / count : std::nan("");
-}
-
 // The larger step across `line` in the gaps on either side of the band
 // (from near_m to far_m beyond its long sides, `px_per_m` across); 0 when
 // neither can be measured (beside an end band only one gap has a bar).

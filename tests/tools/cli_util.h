@@ -83,6 +83,27 @@ inline double HorizontalAfterM(const std::string& poses_output) {
   return 0.01 * std::stod(match[1].str());
 }
 
+// `zebrageo simulate SIMULATE_ARGS -o SURVEY`, then `zebrageo run SURVEY
+// -o RESULTS --threads 2`, as a user runs them, their output kept in
+// `log_folder`. Returns "" or which step failed with its stderr.
+inline std::string SimulateAndRun(const std::string& simulate_args,
+                                  const std::string& survey,
+                                  const std::string& results,
+                                  const std::string& log_folder) {
+  const std::string log = log_folder + "/";
+  if (RunZebrageo("--log-level error simulate " + simulate_args + " -o " +
+                      Quote(survey),
+                  log + "simulate.out", log + "simulate.err") != 0) {
+    return "simulate failed: " + ReadWholeFile(log + "simulate.err");
+  }
+  if (RunZebrageo("--log-level warning run " + Quote(survey) + " -o " +
+                      Quote(results) + " --threads 2",
+                  log + "run.out", log + "run.err") != 0) {
+    return "run failed: " + ReadWholeFile(log + "run.err");
+  }
+  return "";
+}
+
 // A small survey (80 m, 2 crossings, 640x480 images, ~20 exposures) that
 // the whole pipeline processes in a few seconds.
 inline std::string SmallSurveyArguments() {

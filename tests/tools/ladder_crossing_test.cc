@@ -29,20 +29,12 @@ TEST(LadderCrossing, BandsJoiningBarsAreReconstructedAndMatched) {
   TemporaryFolder folder;
   const std::string survey = folder.Path("survey");
   const std::string results = folder.Path("results");
-  ASSERT_EQ(
-      RunZebrageo("--log-level error simulate --preset demo --seed 2 "
-                  "--set ladder_probability=1 --set "
-                  "band_sizes_per_crossing=true --set image_width=1024 "
-                  "--set image_height=768 -o " +
-                      Quote(survey),
-                  folder.Path("simulate.out"), folder.Path("simulate.err")),
-      0)
-      << ReadWholeFile(folder.Path("simulate.err"));
-  ASSERT_EQ(RunZebrageo("--log-level warning run " + Quote(survey) + " -o " +
-                            Quote(results) + " --threads 2",
-                        folder.Path("run.out"), folder.Path("run.err")),
-            0)
-      << ReadWholeFile(folder.Path("run.err"));
+  ASSERT_EQ(SimulateAndRun(
+                "--preset demo --seed 2 --set ladder_probability=1 "
+                "--set band_sizes_per_crossing=true --set image_width=1024 "
+                "--set image_height=768",
+                survey, results, folder.Path()),
+            "");
 
   const Score match =
       ScoreResults("match", survey, results, "--max-wrong 0 --min-matched 1",

@@ -26,19 +26,11 @@ TEST(SteepCamera, CrossingEdgesHoldTheCrossingNoBandIsSeenWholeOf) {
   const std::string survey = folder.Path("survey");
   const std::string results = folder.Path("results");
   ASSERT_EQ(
-      RunZebrageo("--log-level error simulate --preset demo --seed 3 "
-                  "--set camera_pitch_down_deg=30 --set "
-                  "exposure_spacing_m=7.5 --set image_width=1024 --set "
-                  "image_height=768 -o " +
-                      Quote(survey),
-                  folder.Path("simulate.out"), folder.Path("simulate.err")),
-      0)
-      << ReadWholeFile(folder.Path("simulate.err"));
-  ASSERT_EQ(RunZebrageo("--log-level warning run " + Quote(survey) + " -o " +
-                            Quote(results) + " --threads 2",
-                        folder.Path("run.out"), folder.Path("run.err")),
-            0)
-      << ReadWholeFile(folder.Path("run.err"));
+      SimulateAndRun("--preset demo --seed 3 --set camera_pitch_down_deg=30 "
+                     "--set exposure_spacing_m=7.5 --set image_width=1024 "
+                     "--set image_height=768",
+                     survey, results, folder.Path()),
+      "");
   // The crossing whose bands no image holds whole (zc-0110; its bands'
   // far ends are seen) is held by its edge, where the adjusted trajectory
   // puts it within a few centimetres of the database's.
