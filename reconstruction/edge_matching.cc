@@ -65,21 +65,35 @@ bool Matchable(const EdgePoint& e, double min_sin) {
 // Local disparity of every point of every left chain: the median of the
 // matched disparities within +-half_window chain positions (NaN when fewer
 // than 3).
+// The window slides along the chain with its values kept sorted (one
+// insertion and one removal per step), so the median is read off instead
+// of selected again from the whole window at every point: the same upper
+// median as Median().
 std::vector<double> ChainDisparities(const EdgeMap& left,
                                      const std::vector<double>& disparity,
                                      int half_window) {
   std::vector<double> reference(left.points.size(), kNaN);
-  std::vector<double> window;
+  std::vector<double> window;  // sorted
   for (const std::vector<int>& chain : left.chains) {
     const int n = static_cast<int>(chain.size());
+    window.clear();
+    auto insert = [&](int m) {
+      const double d = disparity[chain[m]];
+      if (std::isnan(d)) return;
+      window.insert(std::upper_bound(window.begin(), window.end(), d), d);
+    };
+    auto remove = [&](int m) {
+      const double d = disparity[chain[m]];
+      if (std::isnan(d)) return;
+      window.erase(std::lower_bound(window.begin(), window.end(), d));
+    };
+    for (int m = 0; m <= std::min(n - 1, half_window); ++m) insert(m);
     for (int k = 0; k < n; ++k) {
-      window.clear();
-      for (int m = std::max(0, k - half_window);
-           m <= std::min(n - 1, k + half_window); ++m) {
-        const double d = disparity[chain[m]];
-        if (!std::isnan(d)) window.push_back(d);
-      }
-      if (window.size() >= 3) reference[chain[k]] = Median(window);
+      // window: positions max(0, k - half_window) .. min(n - 1, k +
+      // half_window).
+      if (window.size() >= 3) reference[chain[k]] = window[window.size() / 2];
+      if (k - half_window >= 0) remove(k - half_window);
+      if (k + 1 + half_window < n) insert(k + 1 + half_window);
     }
   }
   return reference;
@@ -158,6 +172,31 @@ class RowMatcher {
       if (Matchable(right_.points[p], min_sin_)) rights_.push_back(p);
     }
     if (lefts_.empty() || rights_.empty()) return;
+    if (reference == nullptr) {
+      FindCandidates(row);
+    } else {
+      WeighWithContinuity(row, *reference);
+    }
+    for (int c :
+         BestOrderedMatching(candidates_, static_cast<int>(rights_.size()))) {
+      const Candidate& candidate = candidates_[c];
+      EdgeMatch match;
+      match.left = lefts_[candidate.i];
+      match.right = rights_[candidate.j];
+      match.x_left = left_.points[match.left].x;
+      match.y = left_.points[match.left].y;
+      match.x_right = candidate.x_right;
+      match.ncc = candidate.ncc;
+      matches->push_back(match);
+    }
+  }
+
+ private:
+  // Pass 1: the candidates of the row (lefts_, rights_), weighed without
+  // continuity, into candidates_; they are also kept for pass 2, whose
+  // candidates are among them (its cost only adds the continuity term), so
+  // that their correlation windows are computed once.
+  void FindCandidates(int row) {
     candidates_.clear();
     const double twice_occlusion = 2.0 * options_.occlusion_cost;
     for (int i = 0; i < static_cast<int>(lefts_.size()); ++i) {
@@ -181,16 +220,7 @@ class RowMatcher {
         const double ncc = WindowNcc(left_image_, right_image_, l.x, x_right,
                                      row, options_.window_radius_px);
         if (ncc < options_.min_ncc) continue;
-        double cost = 1.0 - ncc;
-        if (reference != nullptr) {
-          const double ref = (*reference)[lefts_[i]];
-          const double deviation =
-              std::isnan(ref)
-                  ? 0.5
-                  : std::min(1.0, std::abs(d - ref) /
-                                      options_.continuity_tolerance_px);
-          cost += options_.continuity_weight * deviation;
-        }
+        const double cost = 1.0 - ncc;
         const double weight = twice_occlusion - cost;
         if (weight <= 0.0) continue;
         Candidate c;
@@ -202,21 +232,39 @@ class RowMatcher {
         candidates_.push_back(c);
       }
     }
-    for (int c :
-         BestOrderedMatching(candidates_, static_cast<int>(rights_.size()))) {
-      const Candidate& candidate = candidates_[c];
-      EdgeMatch match;
-      match.left = lefts_[candidate.i];
-      match.right = rights_[candidate.j];
-      match.x_left = left_.points[match.left].x;
-      match.y = left_.points[match.left].y;
-      match.x_right = candidate.x_right;
-      match.ncc = candidate.ncc;
-      matches->push_back(match);
+    first_pass_.emplace_back(row, candidates_);
+  }
+
+  // Pass 2: the row's pass-1 candidates (rows come in the same order)
+  // weighed again with the continuity term, into candidates_.
+  void WeighWithContinuity(int row, const std::vector<double>& reference) {
+    candidates_.clear();
+    while (next_row_ < first_pass_.size() &&
+           first_pass_[next_row_].first < row) {
+      ++next_row_;
+    }
+    if (next_row_ == first_pass_.size() ||
+        first_pass_[next_row_].first != row) {
+      return;
+    }
+    const double twice_occlusion = 2.0 * options_.occlusion_cost;
+    for (const Candidate& found : first_pass_[next_row_].second) {
+      const double d = left_.points[lefts_[found.i]].x - found.x_right;
+      double cost = 1.0 - found.ncc;
+      const double ref = reference[lefts_[found.i]];
+      const double deviation =
+          std::isnan(ref) ? 0.5
+                          : std::min(1.0, std::abs(d - ref) /
+                                              options_.continuity_tolerance_px);
+      cost += options_.continuity_weight * deviation;
+      const double weight = twice_occlusion - cost;
+      if (weight <= 0.0) continue;
+      Candidate c = found;
+      c.weight = weight;
+      candidates_.push_back(c);
     }
   }
 
- private:
   const cv::Mat& left_image_;
   const cv::Mat& right_image_;
   const EdgeMap& left_;
@@ -228,6 +276,9 @@ class RowMatcher {
   std::vector<int> lefts_;
   std::vector<int> rights_;
   std::vector<Candidate> candidates_;
+  // Pass 1's candidates of each row that had some, in row order.
+  std::vector<std::pair<int, std::vector<Candidate>>> first_pass_;
+  size_t next_row_ = 0;
 };
 
 }  // namespace

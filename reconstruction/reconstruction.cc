@@ -137,8 +137,10 @@ StereoPairReconstructor::StereoPairReconstructor(
     const RigCamera& left, const RigCamera& right,
     const RoadPlane& rectification_plane, const ReconstructionOptions& options)
     : cameras_{left, right}, options_(options) {
-  rectification_.Build(left, right, rectification_plane, options.rectification,
-                       &error_);
+  if (rectification_.Build(left, right, rectification_plane,
+                           options.rectification, &error_)) {
+    usable_ = UsableMask(rectification_.valid_mask(), options.edges);
+  }
 }
 
 bool StereoPairReconstructor::ProjectToOriginal(int side,
@@ -153,19 +155,30 @@ PairReconstruction StereoPairReconstructor::Reconstruct(
     const RoadPlane& prior, double slab_half_thickness_m,
     double tolerance_angle_rad, uint64_t seed, bool stop_after_road_plane,
     const std::string& debug_prefix) const {
+  PairWorkspace workspace;
+  return Reconstruct(left_image, right_image, prior, slab_half_thickness_m,
+                     tolerance_angle_rad, seed, stop_after_road_plane,
+                     debug_prefix, &workspace);
+}
+
+PairReconstruction StereoPairReconstructor::Reconstruct(
+    const cv::Mat& left_image, const cv::Mat& right_image,
+    const RoadPlane& prior, double slab_half_thickness_m,
+    double tolerance_angle_rad, uint64_t seed, bool stop_after_road_plane,
+    const std::string& debug_prefix, PairWorkspace* workspace) const {
   PairReconstruction result;
   const RoadRectification& rect = rectification_;
 
   double start = ThreadCpuSeconds();
-  cv::Mat rectified[2];
+  cv::Mat* const rectified = workspace->rectified;
   rect.Rectify(left_image, right_image, &rectified[0], &rectified[1]);
   result.timings.rectify_s = ThreadCpuSeconds() - start;
 
   start = ThreadCpuSeconds();
-  EdgeMap edges[2];
+  const EdgeMap* const edges = workspace->edges;
   for (int side = 0; side < 2; ++side) {
-    edges[side] =
-        DetectSubpixelEdges(rectified[side], rect.valid_mask(), options_.edges);
+    DetectSubpixelEdges(rectified[side], usable_, options_.edges,
+                        &workspace->edge_scratch, &workspace->edges[side]);
     result.edge_points[side] = static_cast<int>(edges[side].points.size());
   }
   result.timings.edges_s = ThreadCpuSeconds() - start;
@@ -258,12 +271,34 @@ struct ExposureResult {
   StepTimings timings;
 };
 
+// The workspaces of the workers, handed out one per exposure in work and
+// taken back after it: a survey's pairs reuse a few workspaces, whichever
+// thread runs them.
+class WorkspacePool {
+ public:
+  std::unique_ptr<PairWorkspace> Take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (free_.empty()) return std::make_unique<PairWorkspace>();
+    std::unique_ptr<PairWorkspace> workspace = std::move(free_.back());
+    free_.pop_back();
+    return workspace;
+  }
+  void Give(std::unique_ptr<PairWorkspace> workspace) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(workspace));
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<PairWorkspace>> free_;
+};
+
 ExposureResult ProcessExposure(
     const Survey& survey, const Exposure& exposure,
     const std::vector<std::unique_ptr<StereoPairReconstructor>>& pairs,
     const ReconstructionOptions& options, const RoadPlane& prior,
     double slab_half_thickness_m, double tolerance_angle_rad,
-    bool stop_after_road_plane, bool write_debug) {
+    bool stop_after_road_plane, bool write_debug, WorkspacePool* pool) {
   ExposureResult result;
   const Rig& rig = survey.rig;
   const int num_pairs = static_cast<int>(rig.stereo_pairs.size());
@@ -298,6 +333,7 @@ ExposureResult ProcessExposure(
     }
   }
   result.timings.read_images_s = ThreadCpuSeconds() - start;
+  std::unique_ptr<PairWorkspace> workspace = pool->Take();
   for (int p = 0; p < num_pairs; ++p) {
     if (!pairs[p]) continue;
     const uint64_t seed =
@@ -315,10 +351,11 @@ ExposureResult ProcessExposure(
     result.pairs[p] = pairs[p]->Reconstruct(
         images[rig.stereo_pairs[p][0]], images[rig.stereo_pairs[p][1]], prior,
         slab_half_thickness_m, tolerance_angle_rad, seed, stop_after_road_plane,
-        debug_prefix);
+        debug_prefix, workspace.get());
     result.pair_ran[p] = true;
     result.timings.Add(result.pairs[p].timings);
   }
+  pool->Give(std::move(workspace));
   return result;
 }
 
@@ -357,11 +394,12 @@ RoadPlane InitialRoadPlane(const Survey& survey, const StereoPairs& pairs,
   const std::vector<int> init_exposures = InitializationExposures(
       static_cast<int>(exposures.size()), options.search);
   std::vector<ExposureResult> init_results(init_exposures.size());
+  WorkspacePool pool;
   ParallelFor(static_cast<int>(init_exposures.size()), threads, [&](int k) {
     init_results[k] = ProcessExposure(
         survey, exposures[init_exposures[k]], pairs, options, nominal,
         options.search.initial_slab_half_thickness_m,
-        options.search.initial_tolerance_angle_rad, true, false);
+        options.search.initial_tolerance_angle_rad, true, false, &pool);
   });
   std::vector<RoadPlane> init_planes;
   for (const ExposureResult& r : init_results) {
@@ -430,6 +468,7 @@ std::vector<ExposureResult> ProcessExposures(
   std::mutex progress_mutex;
   int done = 0;
   const int total = static_cast<int>(exposures.size());
+  WorkspacePool pool;
   for (int begin = 0; begin < total; begin += options.batch_exposures) {
     const int end = std::min(total, begin + options.batch_exposures);
     const RoadPlane prior = running->plane();
@@ -439,7 +478,7 @@ std::vector<ExposureResult> ProcessExposures(
           ProcessExposure(survey, exposures[begin + k], pairs, options, prior,
                           options.search.slab_half_thickness_m,
                           options.search.tolerance_angle_rad, false,
-                          !options.debug_image_folder.empty());
+                          !options.debug_image_folder.empty(), &pool);
       if (progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
         progress(++done, total);

@@ -124,8 +124,20 @@ struct PairReconstruction {
   StepTimings timings;
 };
 
+// The images a stereo pair's reconstruction works on, kept from one pair
+// to the next by a worker (one per thread): the rectified images, their
+// gradients and the detector's working images are then allocated once
+// instead of being faulted in afresh (tens of megabytes) for every pair.
+// Nothing in it carries over into a result.
+struct PairWorkspace {
+  cv::Mat rectified[2];
+  EdgeMap edges[2];
+  EdgeScratch edge_scratch;
+};
+
 // Everything the stages of one stereo pair need that does not change
-// between exposures: the cameras and the rectification tables.
+// between exposures: the cameras, the rectification tables and the mask
+// of usable gradients.
 class StereoPairReconstructor {
  public:
   // `rectification_plane`: the road plane the rectified geometry is built
@@ -149,6 +161,13 @@ class StereoPairReconstructor {
                                  double tolerance_angle_rad, uint64_t seed,
                                  bool stop_after_road_plane,
                                  const std::string& debug_prefix) const;
+  // The same, working in `workspace` (one thread's; the result does not
+  // depend on what it held before).
+  PairReconstruction Reconstruct(
+      const cv::Mat& left_image, const cv::Mat& right_image,
+      const RoadPlane& prior, double slab_half_thickness_m,
+      double tolerance_angle_rad, uint64_t seed, bool stop_after_road_plane,
+      const std::string& debug_prefix, PairWorkspace* workspace) const;
 
   // Pixel of a body point in the original (distorted) image of `side`.
   bool ProjectToOriginal(int side, const Eigen::Vector3d& p_body,
@@ -158,6 +177,7 @@ class StereoPairReconstructor {
   RigCamera cameras_[2];
   ReconstructionOptions options_;
   RoadRectification rectification_;
+  cv::Mat usable_;  // UsableMask of the rectification's valid mask
   std::string error_;
 };
 

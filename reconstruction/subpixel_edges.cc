@@ -97,13 +97,13 @@ namespace {
 // Non-maximum suppression and Devernay's sub-pixel correction of the
 // gradient `norm` of `edges`; `index` (CV_32S, -1 elsewhere) gets each
 // point's index.
-std::vector<EdgePoint> SuppressNonMaxima(const EdgeMap& edges,
-                                         const cv::Mat& norm,
-                                         const EdgeOptions& options,
-                                         cv::Mat* index_out) {
+void SuppressNonMaxima(const EdgeMap& edges, const cv::Mat& norm,
+                       const EdgeOptions& options, cv::Mat* index_out,
+                       std::vector<EdgePoint>* points_out) {
   const cv::Mat& usable = edges.usable;
   cv::Mat& index = *index_out;
-  std::vector<EdgePoint> points;
+  std::vector<EdgePoint>& points = *points_out;
+  points.clear();
   const float low = static_cast<float>(options.low_threshold);
   for (int y = 1; y + 1 < norm.rows; ++y) {
     const float* n0 = norm.ptr<float>(y - 1);
@@ -139,8 +139,6 @@ std::vector<EdgePoint> SuppressNonMaxima(const EdgeMap& edges,
       points.push_back(e);
     }
   }
-
-  return points;
 }
 
 // Chains of the points: each point links to its closest forward
@@ -242,40 +240,61 @@ void KeepChains(const std::vector<EdgePoint>& points,
 
 }  // namespace
 
-EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
-                            const EdgeOptions& options) {
-  CHECK_EQ(image.type(), CV_32F);
-  EdgeMap edges;
-  edges.width = image.cols;
-  edges.height = image.rows;
-  cv::Mat smooth;
-  cv::GaussianBlur(image, smooth, cv::Size(0, 0), options.gaussian_sigma_px,
-                   options.gaussian_sigma_px, cv::BORDER_REPLICATE);
-  cv::Sobel(smooth, edges.gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0,
-            cv::BORDER_REPLICATE);
-  cv::Sobel(smooth, edges.gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0,
-            cv::BORDER_REPLICATE);
-  cv::Mat norm;
-  cv::magnitude(edges.gx, edges.gy, norm);
-
+cv::Mat UsableMask(const cv::Mat& valid_mask, const EdgeOptions& options) {
+  cv::Mat usable;
+  if (valid_mask.empty()) return usable;
   // Gradients within the smoothing support of an invalid pixel are
   // artefacts of the border.
-  cv::Mat& usable = edges.usable;
-  if (!valid_mask.empty()) {
-    const int radius =
-        static_cast<int>(std::ceil(3.0 * options.gaussian_sigma_px)) + 1;
-    cv::erode(valid_mask, usable,
-              cv::getStructuringElement(
-                  cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
-  }
+  const int radius =
+      static_cast<int>(std::ceil(3.0 * options.gaussian_sigma_px)) + 1;
+  cv::erode(valid_mask, usable,
+            cv::getStructuringElement(
+                cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  return usable;
+}
 
-  // Non-maximum suppression and Devernay's sub-pixel correction.
-  cv::Mat index(image.rows, image.cols, CV_32S, cv::Scalar(-1));
-  const std::vector<EdgePoint> points =
-      SuppressNonMaxima(edges, norm, options, &index);
-  const std::vector<std::vector<int>> chains = LinkChains(points, index);
-  KeepChains(points, chains, options, image.rows, &edges);
+EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
+                            const EdgeOptions& options) {
+  EdgeMap edges;
+  EdgeScratch scratch;
+  DetectSubpixelEdges(image, UsableMask(valid_mask, options), options, &scratch,
+                      &edges);
   return edges;
+}
+
+void DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& usable,
+                         const EdgeOptions& options, EdgeScratch* scratch,
+                         EdgeMap* edges_out) {
+  CHECK_EQ(image.type(), CV_32F);
+  EdgeMap& edges = *edges_out;
+  edges.width = image.cols;
+  edges.height = image.rows;
+  edges.points.clear();
+  edges.chains.clear();
+  edges.usable = usable;
+  cv::GaussianBlur(image, scratch->smooth, cv::Size(0, 0),
+                   options.gaussian_sigma_px, options.gaussian_sigma_px,
+                   cv::BORDER_REPLICATE);
+  cv::Sobel(scratch->smooth, edges.gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0,
+            cv::BORDER_REPLICATE);
+  cv::Sobel(scratch->smooth, edges.gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0,
+            cv::BORDER_REPLICATE);
+  cv::magnitude(edges.gx, edges.gy, scratch->norm);
+
+  // Non-maximum suppression and Devernay's sub-pixel correction. The index
+  // image is -1 everywhere between calls: only the points' pixels are
+  // reset after use, not the whole image.
+  cv::Mat& index = scratch->index;
+  if (index.rows != image.rows || index.cols != image.cols ||
+      index.type() != CV_32S) {
+    index.create(image.rows, image.cols, CV_32S);
+    index.setTo(cv::Scalar(-1));
+  }
+  std::vector<EdgePoint>& points = scratch->candidates;
+  SuppressNonMaxima(edges, scratch->norm, options, &index, &points);
+  const std::vector<std::vector<int>> chains = LinkChains(points, index);
+  for (const EdgePoint& e : points) index.at<int>(e.py, e.px) = -1;
+  KeepChains(points, chains, options, image.rows, &edges);
 }
 
 }  // namespace zebrageo

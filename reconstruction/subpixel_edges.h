@@ -85,6 +85,28 @@ struct EdgeMap {
 EdgeMap DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& valid_mask,
                             const EdgeOptions& options);
 
+// The pixels of `valid_mask` (CV_8U, may be empty: then empty) whose
+// gradient is usable: those outside the smoothing support of an invalid
+// pixel. DetectSubpixelEdges computes it from its valid mask; a caller
+// with one mask for many images computes it once (EdgeMap::usable).
+cv::Mat UsableMask(const cv::Mat& valid_mask, const EdgeOptions& options);
+
+// The working images of the detection, kept between calls: images of one
+// size then reuse their memory instead of having the kernel hand out (and
+// zero) fresh pages for every image, which cost more than the filtering.
+struct EdgeScratch {
+  cv::Mat smooth;
+  cv::Mat norm;
+  cv::Mat index;  // CV_32S, -1 everywhere between calls
+  std::vector<EdgePoint> candidates;
+};
+
+// As DetectSubpixelEdges, with `usable` from UsableMask (shared, not
+// copied), into `edges` (its images and vectors reused). The same edges.
+void DetectSubpixelEdges(const cv::Mat& image, const cv::Mat& usable,
+                         const EdgeOptions& options, EdgeScratch* scratch,
+                         EdgeMap* edges);
+
 }  // namespace zebrageo
 
 #endif  // ZEBRAGEO_RECONSTRUCTION_SUBPIXEL_EDGES_H_

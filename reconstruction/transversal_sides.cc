@@ -223,6 +223,12 @@ std::vector<ImageLine> HoughTransversalCandidates(
   const double step = options.hough_rho_step_px;
   const int n_rho = static_cast<int>((rho_max - rho_min) / step) + 2;
   std::vector<float> votes(static_cast<size_t>(n_theta) * n_rho, 0.0f);
+  // The votes of an angle theta_k need phi - theta_k within the tolerance
+  // (modulo 2 pi); when the angles and the tolerance span less than pi,
+  // those k are a run around phi - theta0 (no wrap around can reach them).
+  const double step_t = options.hough_angle_step_rad;
+  const bool narrow =
+      half * step_t + options.point_angle_tolerance_rad + 2.0 * step_t < kPi;
   // Every pixel with a gradient votes, weighted by its norm: transversal
   // sides far away are blurred along the road over several pixels, where
   // non-maximum suppression finds no reliable edge points.
@@ -232,7 +238,22 @@ std::vector<ImageLine> HoughTransversalCandidates(
     const float norm = std::hypot(gx, gy);
     if (norm < options.hough_min_gradient) continue;
     const double phi = std::atan2(gy, gx);
-    for (int k = 0; k < n_theta; ++k) {
+    // Only the angles within the tolerance of phi can vote: their range is
+    // found first (with a step of margin), the test below decides.
+    int k_begin = 0, k_end = n_theta;
+    if (narrow) {
+      const double delta = std::remainder(phi - theta0, 2.0 * kPi);
+      k_begin = std::max(
+          0, static_cast<int>(std::floor(
+                 half + (delta - options.point_angle_tolerance_rad) / step_t)) -
+                 1);
+      k_end = std::min(
+          n_theta,
+          static_cast<int>(std::ceil(
+              half + (delta + options.point_angle_tolerance_rad) / step_t)) +
+              2);
+    }
+    for (int k = k_begin; k < k_end; ++k) {
       const double theta = theta0 + (k - half) * options.hough_angle_step_rad;
       // Oriented: only the expected polarity votes (a shadow edge across
       // the band, darkening into it, must not outvote the paint's end).
