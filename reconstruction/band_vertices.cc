@@ -285,13 +285,24 @@ ViewResult ModelBandInImage(const BandContext& context, int i,
   return ViewResult::kOk;
 }
 
-// Mean height standard deviation of the monoplotted points of `side`
-// (0 when it was triangulated).
-double MonoplotHeightSigma(const LongSideDetection& detection,
-                           const LongSide& side) {
-  double sum = 0.0;
-  for (int k : side.support) sum += detection.points[k].monoplot_height_sigma_m;
-  return side.support.empty() ? 0.0 : sum / side.support.size();
+// The monoplotted point of `side` nearest to `p` (its sigmas grow with the
+// range: those at the vertex's end hold for it); null when the side was
+// triangulated.
+const EdgePoint3d* NearestMonoplotted(const LongSideDetection& detection,
+                                      const LongSide& side,
+                                      const Eigen::Vector3d& p) {
+  const EdgePoint3d* nearest = nullptr;
+  double best = 0.0;
+  for (int k : side.support) {
+    const EdgePoint3d& q = detection.points[k];
+    if (q.monoplot_height_sigma_m <= 0.0) continue;
+    const double d = (q.p_body - p).squaredNorm();
+    if (nearest == nullptr || d < best) {
+      nearest = &q;
+      best = d;
+    }
+  }
+  return nearest;
 }
 
 // Covariance of each vertex: along the band from the transversal line
@@ -328,17 +339,25 @@ void VertexCovariances(const BandContext& context, int i,
             ? std::hypot(sigma_px * metres_per_px, options.ladder_end_sigma_m)
             : sigma_px * metres_per_px;
     const bool inferred = pair.inferred == (v == 0 || v == 3 ? 0 : 1);
-    const double sigma_across =
+    // A monoplotted long side (monoplot.h) is placed by its edge in one
+    // image, whose localisation error grows on the road with the range and
+    // the grazing angle, and by the height of the local surface it was cut
+    // with, whose error moves the side along the ray.
+    const EdgePoint3d* monoplotted =
+        NearestMonoplotted(context.detection, s, p);
+    double sigma_across =
         inferred
             ? pair.inferred_sigma_m
             : std::max(options.min_sigma_m,
                        s.lateral_rms_m /
                            std::sqrt(static_cast<double>(s.support.size())));
-    // A monoplotted long side (monoplot.h) has the height of the local
-    // surface it was cut with: its error moves the side along the ray.
-    const double sigma_height =
-        std::max({options.min_sigma_m, std::sqrt(plane_fit.HeightVariance(p)),
-                  MonoplotHeightSigma(context.detection, s)});
+    if (!inferred && monoplotted != nullptr) {
+      sigma_across =
+          std::hypot(sigma_across, monoplotted->monoplot_across_sigma_m);
+    }
+    const double sigma_height = std::max(
+        {options.min_sigma_m, std::sqrt(plane_fit.HeightVariance(p)),
+         monoplotted != nullptr ? monoplotted->monoplot_height_sigma_m : 0.0});
     const Eigen::Vector3d along_ray = ray / std::abs(plane_normal.dot(ray));
     band->covariances_body[v] =
         sigma_along * sigma_along * x_axis * x_axis.transpose() +

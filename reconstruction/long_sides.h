@@ -142,6 +142,12 @@ struct EdgePoint3d {
   // left image ray cut by the local road surface, whose height has this
   // standard deviation (metres); it moves the point along that ray.
   double monoplot_height_sigma_m = 0.0;
+  // ... and the standard deviation of its position across its edge on the
+  // road from the edge's localisation in the image alone (the ray's
+  // angular error over the grazing angle of the plane through the camera
+  // and the edge: 7-10 cm per pixel at 12 m for an edge across the line of
+  // sight, a side-street band's long side 6 m aside).
+  double monoplot_across_sigma_m = 0.0;
 };
 // Points in order along a left image edge chain.
 struct EdgeChain3d {

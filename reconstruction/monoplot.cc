@@ -146,13 +146,41 @@ std::string MonoplotOptions::Check() const {
   OPTION_GE(check, min_height_points, 3);
   OPTION_GT(check, max_height_spread_m, 0.0);
   OPTION_GT(check, min_height_sigma_m, 0.0);
+  OPTION_GT(check, edge_sigma_px, 0.0);
+  OPTION_GT(check, height_disparity_sigma_px, 0.0);
   return check.problem();
+}
+
+void MonoplotSigmas(const RoadPlane& plane, const Eigen::Vector3d& centre,
+                    const Eigen::Vector3d& p,
+                    const Eigen::Vector3d& edge_direction, double baseline_m,
+                    double pixel_angle_rad, double line_sigma_m,
+                    const MonoplotOptions& options, double* across_sigma_m,
+                    double* height_sigma_m) {
+  const Eigen::Vector3d ray = p - centre;
+  const double range = ray.norm();
+  const Eigen::Vector3d& n = plane.normal_body;
+  // The edge's image line fixes the plane through the camera and the edge
+  // (normal m); moving the point by d across the edge on the road (along
+  // `across`) moves it d |across . m| off that plane, seen at `range`.
+  const Eigen::Vector3d along =
+      (edge_direction - edge_direction.dot(n) * n).normalized();
+  const Eigen::Vector3d across = n.cross(along);
+  const Eigen::Vector3d m = ray.cross(along).normalized();
+  const double grazing = std::max(0.05, std::abs(across.dot(m)));
+  *across_sigma_m = options.edge_sigma_px * pixel_angle_rad * range / grazing;
+  // A triangulated point's height error: its depth error (range^2 / (f B)
+  // per pixel of disparity) along a ray that descends height / range.
+  const double height = std::abs(plane.SignedDistance(centre));
+  *height_sigma_m = std::max(
+      line_sigma_m, options.height_disparity_sigma_px * pixel_angle_rad *
+                        range * height / std::max(baseline_m, 1e-3));
 }
 
 std::vector<EdgeChain3d> MonoplotRowEdges(
     const RoadRectification& rectification, const EdgeMap& left,
     const std::vector<std::vector<std::pair<int, EdgePoint3d>>>& by_chain,
-    const RoadPlane& plane, double keep_distance_m,
+    const RoadPlane& plane, double keep_distance_m, double pixel_angle_rad,
     const MonoplotOptions& options) {
   std::vector<EdgeChain3d> out;
   if (!options.enabled) return out;
@@ -182,9 +210,16 @@ std::vector<EdgeChain3d> MonoplotRowEdges(
     }
     VLOG(3) << "monoplot run of " << chain.points.size() << " points, height "
             << h.a << " + " << h.b << " x, sigma " << h.sigma;
-    if (static_cast<int>(chain.points.size()) >= min_points) {
-      out.push_back(std::move(chain));
+    if (static_cast<int>(chain.points.size()) < min_points) return;
+    const Eigen::Vector3d direction =
+        chain.points.back().p_body - chain.points.front().p_body;
+    for (EdgePoint3d& p : chain.points) {
+      MonoplotSigmas(plane, centre, p.p_body, direction,
+                     rectification.baseline_m(), pixel_angle_rad, h.sigma,
+                     options, &p.monoplot_across_sigma_m,
+                     &p.monoplot_height_sigma_m);
     }
+    out.push_back(std::move(chain));
   };
   // A run goes on over up to max_run_gap_points points whose gradient
   // noise turns them off the rows (worn paint, a blurred far edge).

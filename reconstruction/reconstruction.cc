@@ -216,9 +216,9 @@ PairReconstruction StereoPairReconstructor::Reconstruct(
 
   // The edges along the epipolar lines, monoplotted (issue 51).
   start = ThreadCpuSeconds();
-  std::vector<EdgeChain3d> monoplotted =
-      MonoplotRowEdges(rect, edges[0], by_chain, fit.plane,
-                       options_.road_plane.keep_distance_m, options_.monoplot);
+  std::vector<EdgeChain3d> monoplotted = MonoplotRowEdges(
+      rect, edges[0], by_chain, fit.plane, options_.road_plane.keep_distance_m,
+      1.0 / cameras_[0].camera.fx(), options_.monoplot);
   result.monoplotted_chains = static_cast<int>(monoplotted.size());
   for (EdgeChain3d& chain : monoplotted) chains.push_back(std::move(chain));
   result.timings.monoplot_s = ThreadCpuSeconds() - start;
