@@ -27,6 +27,28 @@ void LogBandPairs(const PlaneFrame& frame, const BandPairs& bands) {
   }
 }
 
+// Which seen pairs span more than their crossing's other seen pairs
+// (LongerThanItsCrossing): far away a band's long sides run on across the
+// short stretch of road to a bicycle square in line with it, and the
+// crossing's other bands, which may fail their own checks at that range,
+// still show the crossing's length.
+std::vector<char> OverlongPairs(const BandPairs& bands,
+                                const BandOptions& options) {
+  std::vector<char> overlong(bands.pairs.size(), 0);
+  for (int i = 0; i < bands.seen; ++i) {
+    std::vector<double> others;
+    for (int j = 0; j < bands.seen; ++j) {
+      if (j != i && bands.crossing_of[j] == bands.crossing_of[i]) {
+        others.push_back(bands.pairs[j].end - bands.pairs[j].begin);
+      }
+    }
+    overlong[i] = LongerThanItsCrossing(
+        bands.pairs[i].end - bands.pairs[i].begin, others, options);
+    VLOG_IF(2, overlong[i]) << "band " << i << ": longer than its crossing's";
+  }
+  return overlong;
+}
+
 }  // namespace
 
 std::vector<Band> ModelBands(const LongSideDetection& detection,
@@ -37,14 +59,18 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                              const BandOptions& options,
                              BandModelingDebug* debug) {
   // 1-2. Pairs of long sides, grouped into crossings and completed.
-  const BandPairs bands =
-      FindBandPairs(detection, frame, rectification, zebra, options, debug);
+  const BandPairs bands = FindBandPairs(detection, frame, rectification, edges,
+                                        zebra, options, debug);
   LogBandPairs(frame, bands);
+  const std::vector<char> overlong =
+      options.drop_overlong_bands ? OverlongPairs(bands, options)
+                                  : std::vector<char>(bands.pairs.size(), 0);
   const int crossings = bands.crossings;
   const int m_all = static_cast<int>(bands.pairs.size());
   // 3. Approximate transversal sides of each crossing: regression on the
   // extremities of its longer long sides (seen bands only).
-  const TransversalSearch search = ApproximateTransversalSides(bands, options);
+  const TransversalSearch search =
+      ApproximateTransversalSides(bands, options, overlong);
   const BandContext context{detection, frame, rectification, edges, zebra,
                             options,   bands, search,        debug};
 
@@ -101,17 +127,23 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       }
       outcome = ModelBand(context, i, along_crossing, nullptr, &band);
     }
+    if (overlong[i]) continue;
     if (outcome == BandOutcome::kBand) result.push_back(band);
     if (outcome == BandOutcome::kNoTransversal ||
         outcome == BandOutcome::kDisagreement) {
       without_transversal.push_back(i);
     }
   }
-  if (!options.infer_hidden_ends || without_transversal.empty()) return result;
-  // 5. Hidden ends: a vehicle parked before a crossing hides the end of its
-  // outer bands; the crossing's end lines give them.
-  InferHiddenEnds(context, without_transversal, crossing_direction,
-                  has_direction, &result);
+  if (options.infer_hidden_ends && !without_transversal.empty()) {
+    // 5. Hidden ends: a vehicle parked before a crossing hides the end of
+    // its outer bands; the crossing's end lines give them.
+    InferHiddenEnds(context, without_transversal, crossing_direction,
+                    has_direction, &result);
+  }
+  // 6. A band longer than its crossing's others runs on into paint beside.
+  if (options.drop_overlong_bands) {
+    result = WithoutOverlongBands(std::move(result), options);
+  }
   return result;
 }
 

@@ -1,5 +1,7 @@
 #include "reconstruction/crossing_regularity.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -55,6 +57,42 @@ bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
   *direction_2d =
       Eigen::Vector2d(std::cos(reference + mean), std::sin(reference + mean));
   return true;
+}
+
+bool LongerThanItsCrossing(double length_m, const std::vector<double>& others,
+                           const BandOptions& options) {
+  if (others.size() < 2) return false;
+  const double median = Median(others);
+  int agreeing = 0;
+  for (double length : others) {
+    agreeing +=
+        std::abs(length - median) <= options.crossing_length_agreement_m;
+  }
+  return agreeing >= 2 &&
+         length_m > median + options.max_crossing_length_excess_m;
+}
+
+std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
+                                       const BandOptions& options) {
+  std::vector<char> drop(bands.size(), 0);
+  for (size_t i = 0; i < bands.size(); ++i) {
+    std::vector<double> others;
+    for (size_t j = 0; j < bands.size(); ++j) {
+      if (j != i && bands[j].crossing == bands[i].crossing) {
+        others.push_back(bands[j].length_m);
+      }
+    }
+    if (!LongerThanItsCrossing(bands[i].length_m, others, options)) continue;
+    VLOG(2) << "band of crossing " << bands[i].crossing << ": "
+            << bands[i].length_m << " m long, longer than its crossing's: "
+            << "dropped";
+    drop[i] = 1;
+  }
+  std::vector<Band> kept;
+  for (size_t i = 0; i < bands.size(); ++i) {
+    if (!drop[i]) kept.push_back(std::move(bands[i]));
+  }
+  return kept;
 }
 
 }  // namespace zebrageo
