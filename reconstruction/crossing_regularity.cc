@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <utility>
 
 #include "survey/math_util.h"
@@ -61,15 +62,18 @@ bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
 
 bool LongerThanItsCrossing(double length_m, const std::vector<double>& others,
                            const BandOptions& options) {
-  if (others.size() < 2) return false;
-  const double median = Median(others);
-  int agreeing = 0;
-  for (double length : others) {
-    agreeing +=
-        std::abs(length - median) <= options.crossing_length_agreement_m;
+  // The reference: the longest of the others that another one confirms
+  // (two bands running on into squares confirm each other: then nothing is
+  // dropped). A band cut short by the image's edge or an occluder is
+  // shorter, never longer, so it never makes a full band look too long.
+  std::vector<double> sorted = others;
+  std::sort(sorted.begin(), sorted.end(), std::greater<double>());
+  for (size_t k = 0; k + 1 < sorted.size(); ++k) {
+    if (sorted[k] - sorted[k + 1] <= options.crossing_length_agreement_m) {
+      return length_m > sorted[k] + options.max_crossing_length_excess_m;
+    }
   }
-  return agreeing >= 2 &&
-         length_m > median + options.max_crossing_length_excess_m;
+  return false;
 }
 
 std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,

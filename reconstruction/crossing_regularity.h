@@ -33,13 +33,14 @@ bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
                           Eigen::Vector2d* direction_2d);
 
 // The bands of `bands` not longer than their crossing's (issue 52): a
-// crossing's bands are painted of one length, so a band longer than the
-// median of its crossing's other bands by more than
-// BandOptions::max_crossing_length_excess_m, when at least two of those
-// agree within crossing_length_agreement_m of their median, is dropped. It
-// runs on into paint beside the crossing in line with it (a bicycle square
-// beyond its end) that the paint gaps (paint_gaps.h) could not tell apart:
-// far away the short stretch of road between them is a pixel or two.
+// crossing's bands are painted of one length, so a band longer by more
+// than BandOptions::max_crossing_length_excess_m than the longest of its
+// crossing's other bands that a third one confirms (within
+// crossing_length_agreement_m) is dropped. It runs on into paint beside
+// the crossing in line with it (a bicycle square beyond its end) that the
+// paint gaps (paint_gaps.h) could not tell apart: far away the short
+// stretch of road between them is a pixel or two. A band cut short by the
+// image's edge or an occluder is never the reference.
 std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
                                        const BandOptions& options);
 
