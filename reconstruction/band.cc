@@ -47,6 +47,11 @@ std::string BandOptions::Check() const {
   OPTION_IN(check, max_ladder_join_step_fraction, "[", 0.0, 1.0, ")");
   OPTION_GT(check, ladder_min_bar_width_m, 0.0);
   OPTION_GT(check, ladder_max_bar_width_m, ladder_min_bar_width_m);
+  OPTION_GT(check, min_paint_gap_m, 0.0);
+  OPTION_IN(check, min_paint_gap_drop_fraction, "(", 0.0, 1.0, "]");
+  OPTION_GE(check, min_piece_widths, 0.0);
+  OPTION_GT(check, max_crossing_length_excess_m, 0.0);
+  OPTION_GT(check, crossing_length_agreement_m, 0.0);
   OPTION_GE(check, ladder_end_sigma_m, 0.0);
   return check.problem();
 }

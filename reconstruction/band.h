@@ -164,6 +164,22 @@ struct BandOptions {
   double ladder_min_bar_width_m = 0.1;
   double ladder_max_bar_width_m = 0.5;
   double ladder_end_sigma_m = 0.008;
+  // Paint gaps (issue 52): a band candidate is cut where both its long
+  // sides stop for at least min_paint_gap_m and, in both images, the
+  // band's middle there is darker than the paint on either side by at
+  // least min_paint_gap_drop_fraction of the paint's step to the road
+  // beside the band (paint_gaps.h); it keeps its longest piece, which must
+  // be at least min_piece_widths band widths long (a bicycle square is as
+  // long as wide). The paint beside a crossing in line with its bands, 0.2
+  // m and more beyond their ends, otherwise joins them.
+  bool cut_at_paint_gaps = true;
+  double min_paint_gap_m = 0.1;
+  double min_paint_gap_drop_fraction = 0.5;
+  double min_piece_widths = 2.0;
+  // A band longer than its crossing's others (crossing_regularity.h).
+  bool drop_overlong_bands = true;
+  double max_crossing_length_excess_m = 0.3;
+  double crossing_length_agreement_m = 0.1;
 
   std::string Check() const;
   template <typename Visitor>
@@ -212,6 +228,13 @@ struct BandOptions {
     v("ladder_min_bar_width_m", ladder_min_bar_width_m);
     v("ladder_max_bar_width_m", ladder_max_bar_width_m);
     v("ladder_end_sigma_m", ladder_end_sigma_m);
+    v("cut_at_paint_gaps", cut_at_paint_gaps);
+    v("min_paint_gap_m", min_paint_gap_m);
+    v("min_paint_gap_drop_fraction", min_paint_gap_drop_fraction);
+    v("min_piece_widths", min_piece_widths);
+    v("drop_overlong_bands", drop_overlong_bands);
+    v("max_crossing_length_excess_m", max_crossing_length_excess_m);
+    v("crossing_length_agreement_m", crossing_length_agreement_m);
   }
 };
 

@@ -2,6 +2,8 @@
 
 #include <glog/logging.h>
 
+#include <cmath>
+
 #include "reconstruction/band_pairs.h"
 #include "reconstruction/crossing_regularity.h"
 #include "reconstruction/hidden_ends.h"
@@ -27,6 +29,39 @@ void LogBandPairs(const PlaneFrame& frame, const BandPairs& bands) {
   }
 }
 
+// Whether a band direction (body frame) runs along the track, within 45
+// degrees of the vehicle's forward axis.
+bool AlongTrack(const Eigen::Vector3d& direction_body) {
+  return std::abs(direction_body.normalized().x()) >= std::sqrt(0.5);
+}
+
+// Which seen pairs span more than their crossing's other seen pairs
+// (LongerThanItsCrossing): far away a band's long sides run on across the
+// short stretch of road to a bicycle square in line with it, and the
+// crossing's other bands, which may fail their own checks at that range,
+// still show the crossing's length.
+std::vector<char> OverlongPairs(const BandPairs& bands,
+                                const BandOptions& options) {
+  std::vector<char> overlong(bands.pairs.size(), 0);
+  for (int i = 0; i < bands.seen; ++i) {
+    // Only bands along the track (the road driven's crossings, where the
+    // paint beside is): a side street's bands, across it and monoplotted
+    // far aside, are cut by the image's edge in ways no other band
+    // confirms (side_street_bands_test lost one).
+    if (!AlongTrack(bands.sides[bands.pairs[i].lo].direction_body)) continue;
+    std::vector<double> others;
+    for (int j = 0; j < bands.seen; ++j) {
+      if (j != i && bands.crossing_of[j] == bands.crossing_of[i]) {
+        others.push_back(bands.pairs[j].end - bands.pairs[j].begin);
+      }
+    }
+    overlong[i] = LongerThanItsCrossing(
+        bands.pairs[i].end - bands.pairs[i].begin, others, options);
+    VLOG_IF(2, overlong[i]) << "band " << i << ": longer than its crossing's";
+  }
+  return overlong;
+}
+
 }  // namespace
 
 std::vector<Band> ModelBands(const LongSideDetection& detection,
@@ -37,14 +72,18 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
                              const BandOptions& options,
                              BandModelingDebug* debug) {
   // 1-2. Pairs of long sides, grouped into crossings and completed.
-  const BandPairs bands =
-      FindBandPairs(detection, frame, rectification, zebra, options, debug);
+  const BandPairs bands = FindBandPairs(detection, frame, rectification, edges,
+                                        zebra, options, debug);
   LogBandPairs(frame, bands);
+  const std::vector<char> overlong =
+      options.drop_overlong_bands ? OverlongPairs(bands, options)
+                                  : std::vector<char>(bands.pairs.size(), 0);
   const int crossings = bands.crossings;
   const int m_all = static_cast<int>(bands.pairs.size());
   // 3. Approximate transversal sides of each crossing: regression on the
   // extremities of its longer long sides (seen bands only).
-  const TransversalSearch search = ApproximateTransversalSides(bands, options);
+  const TransversalSearch search =
+      ApproximateTransversalSides(bands, options, overlong);
   const BandContext context{detection, frame, rectification, edges, zebra,
                             options,   bands, search,        debug};
 
@@ -101,17 +140,30 @@ std::vector<Band> ModelBands(const LongSideDetection& detection,
       }
       outcome = ModelBand(context, i, along_crossing, nullptr, &band);
     }
+    if (overlong[i]) continue;
     if (outcome == BandOutcome::kBand) result.push_back(band);
     if (outcome == BandOutcome::kNoTransversal ||
         outcome == BandOutcome::kDisagreement) {
       without_transversal.push_back(i);
     }
   }
-  if (!options.infer_hidden_ends || without_transversal.empty()) return result;
-  // 5. Hidden ends: a vehicle parked before a crossing hides the end of its
-  // outer bands; the crossing's end lines give them.
-  InferHiddenEnds(context, without_transversal, crossing_direction,
-                  has_direction, &result);
+  if (options.infer_hidden_ends && !without_transversal.empty()) {
+    // 5. Hidden ends: a vehicle parked before a crossing hides the end of
+    // its outer bands; the crossing's end lines give them.
+    InferHiddenEnds(context, without_transversal, crossing_direction,
+                    has_direction, &result);
+  }
+  // 6. A band longer than its crossing's others runs on into paint beside.
+  if (options.drop_overlong_bands) {
+    std::vector<Band> along, across;
+    for (Band& band : result) {
+      (AlongTrack(band.vertices_body[3] - band.vertices_body[0]) ? along
+                                                                 : across)
+          .push_back(std::move(band));
+    }
+    result = WithoutOverlongBands(std::move(along), options);
+    result.insert(result.end(), across.begin(), across.end());
+  }
   return result;
 }
 

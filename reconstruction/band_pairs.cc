@@ -9,6 +9,7 @@
 #include <numeric>
 #include <utility>
 
+#include "reconstruction/paint_gaps.h"
 #include "survey/math_util.h"
 
 namespace zebrageo {
@@ -52,8 +53,10 @@ bool OnePaint(const PlaneFrame& frame, const std::vector<LongSide>& sides,
 // overlapping, with inverse gradients and the bright paint between them,
 // cheapest first.
 std::vector<BandCandidate> SidePairCandidates(
-    const PlaneFrame& frame, const std::vector<LongSide>& sides,
-    const ZebraSpecification& zebra, const BandOptions& options) {
+    const LongSideDetection& detection, const PlaneFrame& frame,
+    const RoadRectification& rectification, const EdgeMap edges[2],
+    const std::vector<LongSide>& sides, const ZebraSpecification& zebra,
+    const BandOptions& options) {
   const int n = static_cast<int>(sides.size());
   std::vector<BandCandidate> candidates;
   for (int i = 0; i < n; ++i) {
@@ -80,13 +83,6 @@ std::vector<BandCandidate> SidePairCandidates(
           options.min_side_overlap_fraction * std::min(a1 - a0, b1 - b0)) {
         continue;
       }
-      // Longer than any band: the inner edge of a lane line and a kerb, or
-      // a lane line's two edges and a gutter, running along the crossing.
-      // Taken as one of its bands it would set the crossing's ends (the
-      // extremities of its longest bands) far from the painted ones.
-      if (overlap > zebra.max_band_length_m + options.max_length_excess_m) {
-        continue;
-      }
       BandCandidate c;
       if (!OnePaint(frame, sides, i, j, a0, a1, b0, b1, &c.edge_between)) {
         continue;
@@ -95,9 +91,25 @@ std::vector<BandCandidate> SidePairCandidates(
       c.hi = j;
       c.begin = std::max(a0, b0);
       c.end = std::min(a1, b1);
+      // One piece of paint: the paint beside the crossing in line with a
+      // band is cut off, and a row of squares is no band.
+      if (options.cut_at_paint_gaps &&
+          CutAtPaintGaps(detection.points_2d, frame, rectification, edges, a, b,
+                         options, &c.begin, &c.end) > 0 &&
+          c.end - c.begin < options.min_piece_widths * zebra.band_width_m) {
+        continue;
+      }
+      // Longer than any band: the inner edge of a lane line and a kerb, or
+      // a lane line's two edges and a gutter, running along the crossing.
+      // Taken as one of its bands it would set the crossing's ends (the
+      // extremities of its longest bands) far from the painted ones.
+      if (c.end - c.begin >
+          zebra.max_band_length_m + options.max_length_excess_m) {
+        continue;
+      }
       c.cost =
           std::abs(width - zebra.band_width_m) / zebra.band_width_tolerance_m -
-          overlap / zebra.min_band_length_m;
+          (c.end - c.begin) / zebra.min_band_length_m;
       candidates.push_back(c);
     }
   }
@@ -442,7 +454,7 @@ void CompleteCrossings(const PlaneFrame& frame, const ZebraSpecification& zebra,
 BandPairs FindBandPairs(const LongSideDetection& detection,
                         const PlaneFrame& frame,
                         const RoadRectification& rectification,
-                        const ZebraSpecification& zebra,
+                        const EdgeMap edges[2], const ZebraSpecification& zebra,
                         const BandOptions& options, BandModelingDebug* debug) {
   BandPairs bands;
   bands.sides = detection.sides;
@@ -450,7 +462,8 @@ BandPairs FindBandPairs(const LongSideDetection& detection,
   std::vector<char> side_used(n, 0);
   bands.pairs = DropLoneBandsWithEdges(
       bands.sides,
-      TakeCheapestPairs(SidePairCandidates(frame, bands.sides, zebra, options),
+      TakeCheapestPairs(SidePairCandidates(detection, frame, rectification,
+                                           edges, bands.sides, zebra, options),
                         &side_used),
       zebra, options);
   if (debug != nullptr) {

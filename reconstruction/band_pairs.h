@@ -14,6 +14,7 @@
 #include "reconstruction/band.h"
 #include "reconstruction/long_sides.h"
 #include "reconstruction/road_rectification.h"
+#include "reconstruction/subpixel_edges.h"
 
 namespace zebrageo {
 
@@ -48,11 +49,13 @@ struct BandPairs {
 
 // Pairs the long sides of `detection` into bands and groups them into
 // crossings; with BandOptions::complete_crossings, completes the crossings.
+// With BandOptions::cut_at_paint_gaps, a pair is cut at its paint gaps in
+// the rectified images' `edges` (paint_gaps.h).
 // `debug` (may be null) gets the pairs' sides in the left rectified image.
 BandPairs FindBandPairs(const LongSideDetection& detection,
                         const PlaneFrame& frame,
                         const RoadRectification& rectification,
-                        const ZebraSpecification& zebra,
+                        const EdgeMap edges[2], const ZebraSpecification& zebra,
                         const BandOptions& options, BandModelingDebug* debug);
 
 }  // namespace zebrageo

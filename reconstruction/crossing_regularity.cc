@@ -1,7 +1,10 @@
 #include "reconstruction/crossing_regularity.h"
 
+#include <glog/logging.h>
+
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <utility>
 
 #include "survey/math_util.h"
@@ -55,6 +58,45 @@ bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
   *direction_2d =
       Eigen::Vector2d(std::cos(reference + mean), std::sin(reference + mean));
   return true;
+}
+
+bool LongerThanItsCrossing(double length_m, const std::vector<double>& others,
+                           const BandOptions& options) {
+  // The reference: the longest of the others that another one confirms
+  // (two bands running on into squares confirm each other: then nothing is
+  // dropped). A band cut short by the image's edge or an occluder is
+  // shorter, never longer, so it never makes a full band look too long.
+  std::vector<double> sorted = others;
+  std::sort(sorted.begin(), sorted.end(), std::greater<double>());
+  for (size_t k = 0; k + 1 < sorted.size(); ++k) {
+    if (sorted[k] - sorted[k + 1] <= options.crossing_length_agreement_m) {
+      return length_m > sorted[k] + options.max_crossing_length_excess_m;
+    }
+  }
+  return false;
+}
+
+std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
+                                       const BandOptions& options) {
+  std::vector<char> drop(bands.size(), 0);
+  for (size_t i = 0; i < bands.size(); ++i) {
+    std::vector<double> others;
+    for (size_t j = 0; j < bands.size(); ++j) {
+      if (j != i && bands[j].crossing == bands[i].crossing) {
+        others.push_back(bands[j].length_m);
+      }
+    }
+    if (!LongerThanItsCrossing(bands[i].length_m, others, options)) continue;
+    VLOG(2) << "band of crossing " << bands[i].crossing << ": "
+            << bands[i].length_m << " m long, longer than its crossing's: "
+            << "dropped";
+    drop[i] = 1;
+  }
+  std::vector<Band> kept;
+  for (size_t i = 0; i < bands.size(); ++i) {
+    if (!drop[i]) kept.push_back(std::move(bands[i]));
+  }
+  return kept;
 }
 
 }  // namespace zebrageo

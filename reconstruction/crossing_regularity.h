@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "reconstruction/band.h"
+
 namespace zebrageo {
 
 // One estimate of the direction of a band's end, with its weight (inverse
@@ -29,6 +31,23 @@ struct EndDirectionObservation {
 bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
                           int crossing, int min_count,
                           Eigen::Vector2d* direction_2d);
+
+// The bands of `bands` not longer than their crossing's (issue 52): a
+// crossing's bands are painted of one length, so a band longer by more
+// than BandOptions::max_crossing_length_excess_m than the longest of its
+// crossing's other bands that a third one confirms (within
+// crossing_length_agreement_m) is dropped. It runs on into paint beside
+// the crossing in line with it (a bicycle square beyond its end) that the
+// paint gaps (paint_gaps.h) could not tell apart: far away the short
+// stretch of road between them is a pixel or two. A band cut short by the
+// image's edge or an occluder is never the reference.
+std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
+                                       const BandOptions& options);
+
+// The rule of WithoutOverlongBands for one band of length `length_m`
+// whose crossing's other bands have lengths `others`.
+bool LongerThanItsCrossing(double length_m, const std::vector<double>& others,
+                           const BandOptions& options);
 
 }  // namespace zebrageo
 

@@ -100,8 +100,9 @@ Eigen::Vector2d AtLateral(const PlaneLine& line, const Eigen::Vector2d& along,
   return origin + t * line.direction;
 }
 
-TransversalSearch ApproximateTransversalSides(const BandPairs& bands,
-                                              const BandOptions& options) {
+TransversalSearch ApproximateTransversalSides(
+    const BandPairs& bands, const BandOptions& options,
+    const std::vector<char>& excluded) {
   const int crossings = bands.crossings;
   const int m = bands.seen;
   const std::vector<BandCandidate>& pairs = bands.pairs;
@@ -115,15 +116,19 @@ TransversalSearch ApproximateTransversalSides(const BandPairs& bands,
   for (int c = 0; c < crossings; ++c) {
     double longest = 0.0;
     Eigen::Vector2d along = Eigen::Vector2d::UnitX();
+    auto votes = [&](int i) {
+      return crossing_of[i] == c &&
+             (excluded.empty() || !excluded[static_cast<size_t>(i)]);
+    };
     for (int i = 0; i < m; ++i) {
-      if (crossing_of[i] != c) continue;
+      if (!votes(i)) continue;
       longest = std::max(longest, pairs[i].end - pairs[i].begin);
       along = sides[pairs[i].lo].direction_2d;
     }
     const Eigen::Vector2d across(-along.y(), along.x());
     std::vector<Eigen::Vector2d> begins, ends;
     for (int i = 0; i < m; ++i) {
-      if (crossing_of[i] != c) continue;
+      if (!votes(i)) continue;
       if (pairs[i].end - pairs[i].begin <
           options.extremity_length_fraction * longest) {
         continue;

@@ -50,8 +50,11 @@ struct TransversalSearch {
   std::vector<PlaneLine> begin_lines;  // one per crossing
   std::vector<PlaneLine> end_lines;
 };
-TransversalSearch ApproximateTransversalSides(const BandPairs& bands,
-                                              const BandOptions& options);
+// `excluded` (empty, or one flag per pair): pairs whose extremities do not
+// vote (longer than their crossing's, band_modeling.cc).
+TransversalSearch ApproximateTransversalSides(
+    const BandPairs& bands, const BandOptions& options,
+    const std::vector<char>& excluded = {});
 
 }  // namespace zebrageo
 
