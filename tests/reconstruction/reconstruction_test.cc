@@ -51,10 +51,6 @@ struct Score {
 class SmallSurvey : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    folder_ = new std::string(
-        (std::filesystem::temp_directory_path() /
-         ("zebrageo-reconstruction-test-" + std::to_string(::getpid())))
-            .string());
     SimulationOptions options;
     ASSERT_EQ(ApplyPreset("demo", &options), "");
     options.seed = 7;
@@ -65,12 +61,26 @@ class SmallSurvey : public ::testing::Test {
     options.exposure_spacing_m = 3.0;
     options.parked_vehicles_per_100m = 8.0;  // distractors
     ASSERT_EQ(options.Check(), "");
-    SimulateSurvey(options, *folder_, nullptr);
+    folder_ =
+        SimulateInTemporaryFolder("zebrageo-reconstruction-test", options);
   }
-  static void TearDownTestSuite() {
+  static void TearDownTestSuite() { RemoveSurvey(folder_); }
+
+  // `options` simulated into a new temporary folder, `name` and this
+  // process's id; RemoveSurvey deletes both.
+  static std::string* SimulateInTemporaryFolder(
+      const std::string& name, const SimulationOptions& options) {
+    auto* folder = new std::string((std::filesystem::temp_directory_path() /
+                                    (name + "-" + std::to_string(::getpid())))
+                                       .string());
+    SimulateSurvey(options, *folder, nullptr);
+    return folder;
+  }
+  static void RemoveSurvey(std::string* folder) {
+    if (folder == nullptr) return;  // the set-up failed before it
     std::error_code ignored;
-    std::filesystem::remove_all(*folder_, ignored);
-    delete folder_;
+    std::filesystem::remove_all(*folder, ignored);
+    delete folder;
   }
 
   // Scores `vertices` against the truth of the survey.
@@ -284,10 +294,6 @@ TEST_F(SmallSurvey, ReconstructsTheVisibleBandsToTheCentimetre) {
 class FarBands : public SmallSurvey {
  protected:
   static void SetUpTestSuite() {
-    far_folder_ = new std::string(
-        (std::filesystem::temp_directory_path() /
-         ("zebrageo-reconstruction-far-test-" + std::to_string(::getpid())))
-            .string());
     SimulationOptions options;
     ASSERT_EQ(ApplyPreset("demo", &options), "");
     options.seed = 11;
@@ -304,13 +310,10 @@ class FarBands : public SmallSurvey {
     options.stereo_baseline_m = 0.9;
     options.skew_probability = 1.0;  // the ends' direction matters
     ASSERT_EQ(options.Check(), "");
-    SimulateSurvey(options, *far_folder_, nullptr);
+    far_folder_ =
+        SimulateInTemporaryFolder("zebrageo-reconstruction-far-test", options);
   }
-  static void TearDownTestSuite() {
-    std::error_code ignored;
-    std::filesystem::remove_all(*far_folder_, ignored);
-    delete far_folder_;
-  }
+  static void TearDownTestSuite() { RemoveSurvey(far_folder_); }
   static std::string* far_folder_;
 };
 
@@ -353,10 +356,6 @@ TEST_F(FarBands, FindsTheFarBandsOfA1024x768RigWithoutAFalseOne) {
 class PaintBeside : public SmallSurvey {
  protected:
   static void SetUpTestSuite() {
-    beside_folder_ = new std::string(
-        (std::filesystem::temp_directory_path() /
-         ("zebrageo-reconstruction-beside-test-" + std::to_string(::getpid())))
-            .string());
     SimulationOptions options;
     ASSERT_EQ(ApplyPreset("demo", &options), "");
     options.seed = 7;
@@ -373,13 +372,10 @@ class PaintBeside : public SmallSurvey {
     options.bike_lane_probability = 1.0;
     options.square_column_probability = 1.0;
     ASSERT_EQ(options.Check(), "");
-    SimulateSurvey(options, *beside_folder_, nullptr);
+    beside_folder_ = SimulateInTemporaryFolder(
+        "zebrageo-reconstruction-beside-test", options);
   }
-  static void TearDownTestSuite() {
-    std::error_code ignored;
-    std::filesystem::remove_all(*beside_folder_, ignored);
-    delete beside_folder_;
-  }
+  static void TearDownTestSuite() { RemoveSurvey(beside_folder_); }
   static Score Reconstruct(bool cut_at_paint_gaps) {
     SurveyLoadOptions load;
     load.load_roadmarks = false;
