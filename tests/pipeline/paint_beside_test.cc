@@ -22,6 +22,7 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utility.hpp>
 #include <set>
 #include <string>
 #include <utility>
@@ -52,6 +53,11 @@ struct Simulated {
 // Simulates the small survey with `knobs` and runs `zebrageo run` on it.
 Simulated SimulateAndRun(const TemporaryFolder& folder, const std::string& name,
                          const std::vector<std::string>& knobs) {
+  // OpenCV as `zebrageo` runs it (tools/zebrageo_main.cc): its own thread
+  // pool off, the stages' workers only. With the pool on, a TBB worker of
+  // OpenCV's pool allocates what one of our workers frees, ordered by TBB's
+  // uninstrumented synchronisation: ThreadSanitizer reports that hand-off.
+  cv::setNumThreads(1);
   SimulationOptions simulation;
   EXPECT_EQ(ApplyPreset("demo", &simulation), "");
   std::vector<std::string> all = {"road_length_m=80",
