@@ -34,33 +34,50 @@ struct CommonGap {
   double lo_start, lo_stop, hi_start, hi_stop;
 };
 
-// The brightness along the straight path from plane point a to b in
-// rectified image `side`, relative to a's (the gradient summed pixel by
-// pixel): (share of the path, brightness) every pixel. Empty when part of
-// the path is not usable.
-std::vector<std::pair<double, double>> BrightnessProfile(
-    const PlaneFrame& frame, const RoadRectification& rect, int side,
-    const EdgeMap& edges, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  std::vector<std::pair<double, double>> profile;
+// The gradient along the straight path from plane point a to b in
+// rectified image `side`, summed pixel by pixel: b's brightness relative to
+// a's in *step, and with `profile` (may be null) the brightness so far,
+// (share of the path, brightness), at a and after every pixel. False when
+// the path is shorter than `min_length_px` or part of it is not usable.
+bool IntegrateBrightness(const PlaneFrame& frame, const RoadRectification& rect,
+                         int side, const EdgeMap& edges,
+                         const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                         double min_length_px, double* step,
+                         std::vector<std::pair<double, double>>* profile) {
   Eigen::Vector2d xa, xb;
   if (!rect.ProjectToRectified(side, frame.To3d(a), &xa) ||
       !rect.ProjectToRectified(side, frame.To3d(b), &xb)) {
-    return profile;
+    return false;
   }
   const Eigen::Vector2d span = xb - xa;
   const double length = span.norm();
-  if (!(length >= 2.0) || length > 1e4) return profile;
+  if (!(length >= min_length_px) || length > 1e4) return false;
   const Eigen::Vector2d unit = span / length;
   const int n = static_cast<int>(std::ceil(length));
   const double du = length / n;
   double brightness = 0.0;
-  profile.push_back({0.0, 0.0});
+  if (profile != nullptr) profile->push_back({0.0, 0.0});
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector2d x = xa + (k + 0.5) * du * unit;
-    if (!edges.IsUsable(x.x(), x.y())) return {};
+    if (!edges.IsUsable(x.x(), x.y())) return false;
     const cv::Vec2f g = edges.GradientAt(x.x(), x.y());
     brightness += du * (unit.x() * g[0] + unit.y() * g[1]);
-    profile.push_back({(k + 1.0) / n, brightness});
+    if (profile != nullptr) profile->push_back({(k + 1.0) / n, brightness});
+  }
+  *step = brightness;
+  return true;
+}
+
+// The brightness profile of IntegrateBrightness over at least 2 pixels;
+// empty when part of the path is not usable.
+std::vector<std::pair<double, double>> BrightnessProfile(
+    const PlaneFrame& frame, const RoadRectification& rect, int side,
+    const EdgeMap& edges, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  std::vector<std::pair<double, double>> profile;
+  double step = 0.0;
+  if (!IntegrateBrightness(frame, rect, side, edges, a, b, 2.0, &step,
+                           &profile)) {
+    profile.clear();
   }
   return profile;
 }
@@ -129,26 +146,8 @@ bool PlaneBrightnessStep(const PlaneFrame& frame,
                          const RoadRectification& rectification, int side,
                          const EdgeMap& edges, const Eigen::Vector2d& a,
                          const Eigen::Vector2d& b, double* step) {
-  Eigen::Vector2d xa, xb;
-  if (!rectification.ProjectToRectified(side, frame.To3d(a), &xa) ||
-      !rectification.ProjectToRectified(side, frame.To3d(b), &xb)) {
-    return false;
-  }
-  const Eigen::Vector2d span = xb - xa;
-  const double length = span.norm();
-  if (!(length >= 1.0) || length > 1e4) return false;
-  const Eigen::Vector2d unit = span / length;
-  const int n = static_cast<int>(std::ceil(length));
-  const double du = length / n;
-  double sum = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const Eigen::Vector2d x = xa + (k + 0.5) * du * unit;
-    if (!edges.IsUsable(x.x(), x.y())) return false;
-    const cv::Vec2f g = edges.GradientAt(x.x(), x.y());
-    sum += du * (unit.x() * g[0] + unit.y() * g[1]);
-  }
-  *step = sum;
-  return true;
+  return IntegrateBrightness(frame, rectification, side, edges, a, b, 1.0, step,
+                             nullptr);
 }
 
 int CutAtPaintGaps(const std::vector<Eigen::Vector2d>& points_2d,
