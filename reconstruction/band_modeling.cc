@@ -36,27 +36,29 @@ bool AlongTrack(const Eigen::Vector3d& direction_body) {
 }
 
 // Which seen pairs span more than their crossing's other seen pairs
-// (LongerThanItsCrossing): far away a band's long sides run on across the
+// (LongerThanTheirCrossings): far away a band's long sides run on across the
 // short stretch of road to a bicycle square in line with it, and the
 // crossing's other bands, which may fail their own checks at that range,
 // still show the crossing's length.
 std::vector<char> OverlongPairs(const BandPairs& bands,
                                 const BandOptions& options) {
-  std::vector<char> overlong(bands.pairs.size(), 0);
+  const std::vector<int> crossing_of(bands.crossing_of.begin(),
+                                     bands.crossing_of.begin() + bands.seen);
+  std::vector<double> length_m;
+  for (int i = 0; i < bands.seen; ++i) {
+    length_m.push_back(bands.pairs[i].end - bands.pairs[i].begin);
+  }
+  std::vector<char> overlong =
+      LongerThanTheirCrossings(crossing_of, length_m, options);
+  overlong.resize(bands.pairs.size(), 0);
   for (int i = 0; i < bands.seen; ++i) {
     // Only bands along the track (the road driven's crossings, where the
     // paint beside is): a side street's bands, across it and monoplotted
     // far aside, are cut by the image's edge in ways no other band
     // confirms (side_street_bands_test lost one).
-    if (!AlongTrack(bands.sides[bands.pairs[i].lo].direction_body)) continue;
-    std::vector<double> others;
-    for (int j = 0; j < bands.seen; ++j) {
-      if (j != i && bands.crossing_of[j] == bands.crossing_of[i]) {
-        others.push_back(bands.pairs[j].end - bands.pairs[j].begin);
-      }
+    if (!AlongTrack(bands.sides[bands.pairs[i].lo].direction_body)) {
+      overlong[i] = 0;
     }
-    overlong[i] = LongerThanItsCrossing(
-        bands.pairs[i].end - bands.pairs[i].begin, others, options);
     VLOG_IF(2, overlong[i]) << "band " << i << ": longer than its crossing's";
   }
   return overlong;

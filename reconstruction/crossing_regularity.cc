@@ -60,41 +60,61 @@ bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
   return true;
 }
 
-bool LongerThanItsCrossing(double length_m, const std::vector<double>& others,
+namespace {
+
+// Whether a band of `length_m` is longer than the longest of its crossing's
+// `others` that another one confirms (two bands running on into squares
+// confirm each other: then nothing is dropped). A band cut short by the
+// image's edge or an occluder is shorter, never longer, so it never makes a
+// full band look too long.
+bool LongerThanItsCrossing(double length_m, std::vector<double> others,
                            const BandOptions& options) {
-  // The reference: the longest of the others that another one confirms
-  // (two bands running on into squares confirm each other: then nothing is
-  // dropped). A band cut short by the image's edge or an occluder is
-  // shorter, never longer, so it never makes a full band look too long.
-  std::vector<double> sorted = others;
-  std::sort(sorted.begin(), sorted.end(), std::greater<double>());
-  for (size_t k = 0; k + 1 < sorted.size(); ++k) {
-    if (sorted[k] - sorted[k + 1] <= options.crossing_length_agreement_m) {
-      return length_m > sorted[k] + options.max_crossing_length_excess_m;
+  std::sort(others.begin(), others.end(), std::greater<double>());
+  for (size_t k = 0; k + 1 < others.size(); ++k) {
+    if (others[k] - others[k + 1] <= options.crossing_length_agreement_m) {
+      return length_m > others[k] + options.max_crossing_length_excess_m;
     }
   }
   return false;
 }
 
-std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
-                                       const BandOptions& options) {
-  std::vector<char> drop(bands.size(), 0);
-  for (size_t i = 0; i < bands.size(); ++i) {
+}  // namespace
+
+std::vector<char> LongerThanTheirCrossings(const std::vector<int>& crossing_of,
+                                           const std::vector<double>& length_m,
+                                           const BandOptions& options) {
+  std::vector<char> longer(length_m.size(), 0);
+  for (size_t i = 0; i < length_m.size(); ++i) {
     std::vector<double> others;
-    for (size_t j = 0; j < bands.size(); ++j) {
-      if (j != i && bands[j].crossing == bands[i].crossing) {
-        others.push_back(bands[j].length_m);
+    for (size_t j = 0; j < length_m.size(); ++j) {
+      if (j != i && crossing_of[j] == crossing_of[i]) {
+        others.push_back(length_m[j]);
       }
     }
-    if (!LongerThanItsCrossing(bands[i].length_m, others, options)) continue;
-    VLOG(2) << "band of crossing " << bands[i].crossing << ": "
-            << bands[i].length_m << " m long, longer than its crossing's: "
-            << "dropped";
-    drop[i] = 1;
+    longer[i] = LongerThanItsCrossing(length_m[i], std::move(others), options);
   }
+  return longer;
+}
+
+std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
+                                       const BandOptions& options) {
+  std::vector<int> crossing_of;
+  std::vector<double> length_m;
+  for (const Band& band : bands) {
+    crossing_of.push_back(band.crossing);
+    length_m.push_back(band.length_m);
+  }
+  const std::vector<char> drop =
+      LongerThanTheirCrossings(crossing_of, length_m, options);
   std::vector<Band> kept;
   for (size_t i = 0; i < bands.size(); ++i) {
-    if (!drop[i]) kept.push_back(std::move(bands[i]));
+    if (drop[i]) {
+      VLOG(2) << "band of crossing " << bands[i].crossing << ": "
+              << bands[i].length_m << " m long, longer than its crossing's: "
+              << "dropped";
+      continue;
+    }
+    kept.push_back(std::move(bands[i]));
   }
   return kept;
 }

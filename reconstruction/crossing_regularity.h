@@ -44,10 +44,11 @@ bool CrossingEndDirection(const std::vector<EndDirectionObservation>& all,
 std::vector<Band> WithoutOverlongBands(std::vector<Band> bands,
                                        const BandOptions& options);
 
-// The rule of WithoutOverlongBands for one band of length `length_m`
-// whose crossing's other bands have lengths `others`.
-bool LongerThanItsCrossing(double length_m, const std::vector<double>& others,
-                           const BandOptions& options);
+// The rule of WithoutOverlongBands for bands given by the crossing and the
+// length of each: 1 for each band longer than its crossing's others.
+std::vector<char> LongerThanTheirCrossings(const std::vector<int>& crossing_of,
+                                           const std::vector<double>& length_m,
+                                           const BandOptions& options);
 
 }  // namespace zebrageo
 
